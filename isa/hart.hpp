@@ -1,0 +1,42 @@
+// Architectural state of one hardware thread, and the contract of execute().
+#pragma once
+#include "isa.hpp"
+
+namespace tpsim::isa {
+
+/// Registers and the machine-mode CSRs a bare-metal program uses. No timing, no memory.
+struct Hart {
+    uint32_t reg[kNumRegs] = {};  ///< unified file (see isa.hpp); reg[0] is always 0
+    uint32_t pc = 0;
+    uint32_t fflags = 0;          ///< accrued exception flags NV|DZ|OF|UF|NX (bits 4..0)
+    uint32_t frm = 0;             ///< dynamic rounding mode
+    uint32_t mstatus = 0, mtvec = 0, mepc = 0, mcause = 0, mtval = 0, mscratch = 0;
+    uint32_t mie = 0, mip = 0;
+    uint64_t instret = 0;
+
+    float f(unsigned i) const;    ///< f-register i as a float
+};
+
+/// Sets the trap CSRs and jumps to mtvec (direct mode), as a machine-mode trap does.
+inline void trap(Hart& h, uint32_t cause, uint32_t tval) {
+    h.mepc = h.pc;
+    h.mcause = cause;
+    h.mtval = tval;
+    h.pc = h.mtvec & ~3u;
+}
+
+// execute() lives in execute.hpp:
+//
+//   template <class Env> void execute(const Decoded& d, Hart& h, Env& env);
+//
+// runs one instruction, updating registers, pc (always; next pc or branch target) and CSRs.
+// Env supplies everything outside the hart:
+//   template <class T> T    env.load(uint32_t addr);          // T: u8/i8/u16/i16/u32; may throw
+//   template <class T> void env.store(uint32_t addr, T value); // may throw
+//   uint32_t env.atomic_inc(uint32_t global_register);         // returns the old value
+//   bool env.read_csr(uint32_t csr, uint32_t& value);          // machine CSRs (mhartid, cycle,
+//                                                              // custom); false = not mine
+//   void env.ecall(Hart& h);  void env.ebreak(Hart& h);        // pc still at the instruction
+//   void env.illegal(Hart& h, const Decoded& d);               // pc still at the instruction
+
+}  // namespace tpsim::isa

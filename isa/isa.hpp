@@ -1,0 +1,77 @@
+// The tpsim instruction set: RV32I + M + F + Zicsr + the small tpsim custom extension.
+// Every instruction is defined once, in instructions.def; everything here is derived from it.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+namespace tpsim::isa {
+
+/// One enumerator per instruction in instructions.def, plus Illegal for undecodable words.
+enum class Op : uint16_t {
+#define TPSIM_INSN(name, ...) name,
+#include "instructions.def"
+#undef TPSIM_INSN
+    Illegal,
+    Count
+};
+
+/// Encoding formats; they decide which fields carry registers and immediates.
+enum class Format : uint8_t { R, R4, I, S, B, U, J, Csr, CsrImm, Fence, System };
+
+/// The functional-unit class that executes an instruction: the timing model keys on this only.
+enum class FuClass : uint8_t {
+    IntAlu,   ///< add, logic, shifts, compares, lui/auipc
+    IntMul,   ///< mul, mulh*
+    IntDiv,   ///< div*, rem*
+    FpAdd,    ///< fadd, fsub
+    FpMul,    ///< fmul, fused multiply-add family
+    FpDiv,    ///< fdiv
+    FpSqrt,   ///< fsqrt
+    FpMisc,   ///< compare, min/max, sign injection, classify, move, convert
+    Branch,   ///< conditional branches and jumps
+    Load,     ///< lw/lh/lb/flw ...
+    Store,    ///< sw/sh/sb/fsw ...
+    Atomic,   ///< global-register atomics (tpsim custom extension)
+    System,   ///< csr*, fence*, ecall, ebreak, mret
+    Count
+};
+
+std::string_view to_string(FuClass fu);
+
+/// Register operands live in one unified 65-entry file so the timing model's scoreboard is a
+/// flat array: 0..31 are x0..x31, 32..63 are f0..f31, and kSink absorbs writes to x0.
+constexpr uint8_t kFpBase = 32;
+constexpr uint8_t kSink = 64;
+constexpr uint8_t kNumRegs = 65;
+constexpr uint8_t kNoReg = 0xFF;  ///< operand slot unused
+
+/// A pre-decoded instruction: decode once, execute many times.
+struct Decoded {
+    Op op = Op::Illegal;
+    uint8_t rd = kNoReg;   ///< unified index; kSink for x0; kNoReg if none
+    uint8_t rs1 = kNoReg;  ///< unified index; kNoReg if not read
+    uint8_t rs2 = kNoReg;
+    uint8_t rs3 = kNoReg;
+    uint8_t rm = 0;        ///< FP rounding-mode field (7 = dynamic)
+    int32_t imm = 0;       ///< sign-extended immediate; CSR number for Zicsr
+};
+
+/// Static facts about one instruction, straight from the table.
+struct InsnInfo {
+    std::string_view mnemonic;
+    uint32_t match;
+    uint32_t mask;
+    Format format;
+    FuClass fu;
+};
+
+const InsnInfo& info(Op op);
+
+/// Decodes one 32-bit word; returns op == Op::Illegal when no table entry matches.
+Decoded decode(uint32_t word);
+
+/// Disassembles one word as at address pc, in the syntax of llvm-objdump (e.g. "addi a0, a0, 1").
+std::string disassemble(uint32_t word, uint32_t pc);
+
+}  // namespace tpsim::isa
