@@ -1,0 +1,69 @@
+// Statistics registry: counters live as plain uint64_t fields inside the components that bump
+// them (no lookups at run time); they are registered once, by address, under hierarchical names
+// such as "tm3/l1/misses", and printed by separate printers (text, JSON).
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <iosfwd>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace tpsim::stats {
+
+/// One registered statistic: an integer (counters and sums of counters, printed exactly) or a
+/// real number (ratios, rates, host time). Values are read when printed, never cached.
+struct Entry {
+    std::string name;         ///< hierarchical, '/'-separated, e.g. "tm0/l1/hits"
+    std::string description;  ///< one line, shown in the text report
+    std::string unit;         ///< e.g. "cycles", "B/cycle"; empty if dimensionless
+    std::function<uint64_t()> integer;  ///< set for integer entries
+    std::function<double()> real;       ///< set for real entries
+
+    bool is_integer() const { return static_cast<bool>(integer); }
+    double value() const { return integer ? static_cast<double>(integer()) : real(); }
+};
+
+/// Registered statistics in registration order (that order is the print order, so output is
+/// deterministic). Entries point at storage owned elsewhere: keep the owners alive while
+/// printing.
+class Registry {
+public:
+    /// Registers an integer counter. Throws std::invalid_argument on a malformed or duplicate name.
+    void add_counter(std::string name, const uint64_t& counter, std::string description,
+                     std::string unit = "");
+    /// Registers a real-valued quantity that the caller updates (e.g. host seconds).
+    void add_number(std::string name, const double& number, std::string description,
+                    std::string unit = "");
+    /// Registers a value computed from others when printed (ratios, rates).
+    void add_derived(std::string name, std::function<double()> derive, std::string description,
+                     std::string unit = "");
+    /// numerator / denominator of two already registered entries; 0 when the denominator is 0.
+    void add_ratio(std::string name, std::string_view numerator, std::string_view denominator,
+                   std::string description, std::string unit = "");
+    /// Sum of every already registered entry whose name matches `pattern`, where a '*' segment
+    /// matches any one segment ("tm*/l1/misses"). An integer when all parts are integers.
+    /// Throws std::invalid_argument if nothing matches.
+    void add_sum(std::string name, std::string_view pattern, std::string description,
+                 std::string unit = "");
+
+    const std::vector<Entry>& entries() const { return entries_; }
+    /// The entry called `name`; throws std::out_of_range naming it if absent.
+    const Entry& at(std::string_view name) const;
+    bool contains(std::string_view name) const;
+    double value(std::string_view name) const { return at(name).value(); }
+
+private:
+    void add(Entry entry);
+    std::vector<Entry> entries_;
+};
+
+/// True when `name` matches `pattern` segment by segment ('*' matches one whole segment).
+bool matches(std::string_view pattern, std::string_view name);
+
+/// Aligned human-readable report: name, value, unit, description; one line per entry.
+void print_text(const Registry& registry, std::ostream& out);
+/// One flat JSON object {"name": value, ...} in registration order; non-finite values as null.
+void print_json(const Registry& registry, std::ostream& out);
+
+}  // namespace tpsim::stats
