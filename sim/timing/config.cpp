@@ -1,0 +1,272 @@
+#include "config.hpp"
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include <bit>
+#include <charconv>
+#include <optional>
+#include <type_traits>
+
+namespace tpsim::timing {
+
+namespace {
+
+struct Range {
+    uint32_t min, max;
+};
+
+// The one list of configurable fields: key, storage and allowed range. Loading, overriding,
+// validation and printing all walk it, so a field cannot be forgotten by one of them.
+template <class Config, class Visit>
+void for_each_field(Config& c, Visit&& visit) {
+    constexpr uint32_t kMaxLatency = 100000;
+    visit("chip.clock_mhz", c.chip.clock_mhz, Range{1, 100000});
+    visit("chip.num_tms", c.chip.num_tms, Range{1, 4096});
+    visit("chip.tps_per_tm", c.chip.tps_per_tm, Range{1, 1024});
+    visit("chip.tms_per_l2", c.chip.tms_per_l2, Range{1, 4096});
+    visit("tp.branch_taken_penalty", c.tp.branch_taken_penalty, Range{0, 1000});
+    visit("tp.branch_not_taken_penalty", c.tp.branch_not_taken_penalty, Range{0, 1000});
+    visit("tp.local_store_bytes", c.tp.local_store_bytes, Range{64, 1u << 24});
+    visit("tp.local_store_latency", c.tp.local_store_latency, Range{1, kMaxLatency});
+    auto pool = [&](std::string_view name, auto& fu) {
+        visit(fmt::format("fu.{}.count", name), fu.count, Range{1, 1024});
+        visit(fmt::format("fu.{}.latency", name), fu.latency, Range{1, kMaxLatency});
+        visit(fmt::format("fu.{}.pipelined", name), fu.pipelined, Range{0, 1});
+    };
+    pool("int_alu", c.fu.int_alu);
+    pool("int_muldiv", c.fu.int_muldiv);
+    pool("fp_add", c.fu.fp_add);
+    pool("fp_mul", c.fu.fp_mul);
+    pool("fp_divsqrt", c.fu.fp_divsqrt);
+    pool("fp_misc", c.fu.fp_misc);
+    pool("branch", c.fu.branch);
+    pool("load_store", c.fu.load_store);
+    pool("atomic", c.fu.atomic);
+    visit("icache.threads_per_icache", c.icache.threads_per_icache, Range{1, 1024});
+    visit("icache.banks", c.icache.banks, Range{1, 1024});
+    auto cache = [&](std::string_view name, auto& cc) {
+        visit(fmt::format("{}.size_bytes", name), cc.size_bytes, Range{64, 1u << 30});
+        visit(fmt::format("{}.ways", name), cc.ways, Range{1, 64});
+        visit(fmt::format("{}.line_bytes", name), cc.line_bytes, Range{4, 4096});
+        visit(fmt::format("{}.banks", name), cc.banks, Range{1, 1024});
+        visit(fmt::format("{}.hit_latency", name), cc.hit_latency, Range{1, kMaxLatency});
+        visit(fmt::format("{}.mshrs", name), cc.mshrs, Range{1, 4096});
+    };
+    cache("l1", c.l1);
+    cache("l2", c.l2);
+    visit("dram.channels", c.dram.channels, Range{1, 256});
+    visit("dram.banks", c.dram.banks, Range{1, 256});
+    visit("dram.row_bytes", c.dram.row_bytes, Range{64, 1u << 20});
+    visit("dram.queue_depth", c.dram.queue_depth, Range{1, 4096});
+    visit("dram.tRCD", c.dram.tRCD, Range{1, 1000});
+    visit("dram.tCL", c.dram.tCL, Range{1, 1000});
+    visit("dram.tCWL", c.dram.tCWL, Range{1, 1000});
+    visit("dram.tRP", c.dram.tRP, Range{1, 1000});
+    visit("dram.tRAS", c.dram.tRAS, Range{1, 1000});
+    visit("dram.tBURST", c.dram.tBURST, Range{1, 1000});
+    visit("dram.tCCD", c.dram.tCCD, Range{1, 1000});
+    visit("dram.tRRD", c.dram.tRRD, Range{1, 1000});
+    visit("dram.tWR", c.dram.tWR, Range{1, 1000});
+    visit("dram.tWTR", c.dram.tWTR, Range{1, 1000});
+    visit("dram.tRTP", c.dram.tRTP, Range{1, 1000});
+    visit("global_registers.latency", c.global_registers.latency, Range{1, kMaxLatency});
+    visit("global_registers.per_cycle", c.global_registers.per_cycle, Range{1, 1024});
+    visit("global_registers.link_latency", c.global_registers.link_latency,
+          Range{1, kMaxLatency});
+}
+
+template <class T>
+constexpr bool kIsBool = std::is_same_v<std::remove_cvref_t<T>, bool>;
+
+std::string range_text(bool is_bool, Range r) {
+    return is_bool ? "true or false" : fmt::format("{}..{}", r.min, r.max);
+}
+
+// Sets `key` to a value already parsed as bool or integer; returns false if no such key.
+// `where` prefixes every error ("file:line" or "override 'k=v'").
+bool assign(ChipConfig& config, std::string_view key, std::optional<bool> as_bool,
+            std::optional<int64_t> as_int, std::string_view where) {
+    bool found = false;
+    for_each_field(config, [&](std::string_view name, auto& field, Range range) {
+        if (name != key) return;
+        found = true;
+        if constexpr (kIsBool<decltype(field)>) {
+            if (!as_bool)
+                throw ConfigError(fmt::format("{}: {} must be true or false", where, key));
+            field = *as_bool;
+        } else {
+            if (!as_int)
+                throw ConfigError(fmt::format("{}: {} must be an integer in {}", where, key,
+                                              range_text(false, range)));
+            if (*as_int < range.min || *as_int > range.max)
+                throw ConfigError(fmt::format("{}: {} = {} is out of range; allowed {}", where,
+                                              key, *as_int, range_text(false, range)));
+            field = static_cast<uint32_t>(*as_int);
+        }
+    });
+    return found;
+}
+
+[[noreturn]] void unknown_key(std::string_view where, std::string_view key) {
+    throw ConfigError(fmt::format(
+        "{}: unknown key '{}'; run with --print-config to list the valid keys", where, key));
+}
+
+void load_table(ChipConfig& config, const toml::table& table, const std::string& prefix,
+                std::string_view source_name) {
+    for (const auto& [k, node] : table) {
+        const std::string key = prefix.empty() ? std::string(k.str())
+                                               : fmt::format("{}.{}", prefix, k.str());
+        const std::string where = fmt::format("{}:{}", source_name, node.source().begin.line);
+        if (const toml::table* sub = node.as_table()) {
+            load_table(config, *sub, key, source_name);
+            continue;
+        }
+        std::optional<bool> as_bool;
+        std::optional<int64_t> as_int;
+        if (auto b = node.value_exact<bool>()) as_bool = *b;
+        if (auto i = node.value_exact<int64_t>()) as_int = *i;
+        if (!assign(config, key, as_bool, as_int, where)) unknown_key(where, key);
+    }
+}
+
+bool is_pow2(uint32_t v) { return std::has_single_bit(v); }
+
+void check(bool ok, std::string_view message) {
+    if (!ok) throw ConfigError(std::string(message));
+}
+
+void validate_cache(const CacheConfig& c, std::string_view name) {
+    check(is_pow2(c.line_bytes),
+          fmt::format("{}.line_bytes = {} must be a power of two", name, c.line_bytes));
+    const uint64_t set_bytes = uint64_t{c.ways} * c.line_bytes;
+    check(c.size_bytes % set_bytes == 0 && is_pow2(static_cast<uint32_t>(c.size_bytes / set_bytes)),
+          fmt::format("{0}.size_bytes = {1} must be a power-of-two multiple of {0}.ways x "
+                      "{0}.line_bytes = {2}",
+                      name, c.size_bytes, set_bytes));
+}
+
+}  // namespace
+
+void validate(const ChipConfig& config) {
+    // Ranges first (a config built in code may not have come through the loader).
+    for_each_field(config, [](std::string_view name, const auto& field, Range range) {
+        if constexpr (!kIsBool<decltype(field)>)
+            check(field >= range.min && field <= range.max,
+                  fmt::format("{} = {} is out of range; allowed {}", name, field,
+                              range_text(false, range)));
+    });
+    validate_cache(config.l1, "l1");
+    validate_cache(config.l2, "l2");
+    check(config.l1.line_bytes == config.l2.line_bytes,
+          fmt::format("l2.line_bytes = {} must equal l1.line_bytes = {} (one line size "
+                      "throughout the hierarchy)",
+                      config.l2.line_bytes, config.l1.line_bytes));
+    check(is_pow2(config.dram.row_bytes) && config.dram.row_bytes >= config.l2.line_bytes,
+          fmt::format("dram.row_bytes = {} must be a power of two >= l2.line_bytes = {}",
+                      config.dram.row_bytes, config.l2.line_bytes));
+    check(config.tp.local_store_bytes % 16 == 0,
+          fmt::format("tp.local_store_bytes = {} must be a multiple of 16 (stack alignment)",
+                      config.tp.local_store_bytes));
+    check(config.dram.tRAS >= config.dram.tRCD,
+          fmt::format("dram.tRAS = {} must be >= dram.tRCD = {}", config.dram.tRAS,
+                      config.dram.tRCD));
+}
+
+ChipConfig parse_config(std::string_view toml_text, std::string_view source_name,
+                        const ChipConfig& base) {
+    ChipConfig config = base;
+    toml::table table;
+    try {
+        table = toml::parse(toml_text, source_name);
+    } catch (const toml::parse_error& e) {
+        throw ConfigError(fmt::format("{}:{}: {}", source_name, e.source().begin.line,
+                                      e.description()));
+    }
+    load_table(config, table, "", source_name);
+    try {
+        validate(config);
+    } catch (const ConfigError& e) {
+        throw ConfigError(fmt::format("{}: {}", source_name, e.what()));
+    }
+    return config;
+}
+
+ChipConfig load_config(const std::string& path) {
+    toml::table table;
+    try {
+        table = toml::parse_file(path);
+    } catch (const toml::parse_error& e) {
+        throw ConfigError(fmt::format("{}:{}: {}", path, e.source().begin.line, e.description()));
+    }
+    ChipConfig config;
+    load_table(config, table, "", path);
+    try {
+        validate(config);
+    } catch (const ConfigError& e) {
+        throw ConfigError(fmt::format("{}: {}", path, e.what()));
+    }
+    return config;
+}
+
+void apply_override(ChipConfig& config, std::string_view assignment) {
+    const std::string where = fmt::format("override '{}'", assignment);
+    const size_t eq = assignment.find('=');
+    if (eq == std::string_view::npos)
+        throw ConfigError(fmt::format("{}: expected key=value, e.g. l1.size_bytes=16384", where));
+    auto trim = [](std::string_view s) {
+        while (!s.empty() && s.front() == ' ') s.remove_prefix(1);
+        while (!s.empty() && s.back() == ' ') s.remove_suffix(1);
+        return s;
+    };
+    const std::string_view key = trim(assignment.substr(0, eq));
+    const std::string_view text = trim(assignment.substr(eq + 1));
+    std::optional<bool> as_bool;
+    std::optional<int64_t> as_int;
+    if (text == "true") as_bool = true;
+    if (text == "false") as_bool = false;
+    int64_t number = 0;
+    const bool hex = text.starts_with("0x");
+    const std::string_view digits = hex ? text.substr(2) : text;
+    const auto [end, ec] =
+        std::from_chars(digits.data(), digits.data() + digits.size(), number, hex ? 16 : 10);
+    if (ec == std::errc{} && end == digits.data() + digits.size() && !digits.empty())
+        as_int = number;
+    ChipConfig updated = config;
+    if (!assign(updated, key, as_bool, as_int, where)) unknown_key(where, key);
+    try {
+        validate(updated);
+    } catch (const ConfigError& e) {
+        throw ConfigError(fmt::format("{}: {}", where, e.what()));
+    }
+    config = updated;
+}
+
+std::string to_toml(const ChipConfig& config) {
+    std::string out;
+    std::string section;
+    for_each_field(config, [&](std::string_view name, const auto& field, Range range) {
+        const size_t dot = name.rfind('.');
+        const std::string_view this_section = name.substr(0, dot);
+        if (this_section != section) {
+            section = this_section;
+            out += fmt::format("{}[{}]\n", out.empty() ? "" : "\n", section);
+        }
+        const std::string value = fmt::format("{}", field);
+        out += fmt::format("{:<26} = {:<8} # {}\n", name.substr(dot + 1), value,
+                           range_text(kIsBool<decltype(field)>, range));
+    });
+    return out;
+}
+
+std::vector<std::string> config_keys() {
+    std::vector<std::string> keys;
+    const ChipConfig defaults;
+    for_each_field(defaults, [&](std::string_view name, const auto&, Range) {
+        keys.emplace_back(name);
+    });
+    return keys;
+}
+
+}  // namespace tpsim::timing

@@ -1,0 +1,139 @@
+// Chip configuration: one plain struct per component, defaults in exactly one place (the member
+// initialisers below, which are the TRaX-like chip of configs/trax.toml), loaded from TOML,
+// overridable field by field, validated with messages naming the key and its allowed range.
+#pragma once
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace tpsim::timing {
+
+/// Thrown for any configuration problem; the message names the file:line or override, the key
+/// and the allowed range.
+struct ConfigError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+/// [chip] The shape of the whole chip.
+struct ChipShape {
+    uint32_t clock_mhz = 1000;  ///< core clock; converts cycles to seconds in reports
+    uint32_t num_tms = 4;       ///< thread multiprocessors on the chip
+    uint32_t tps_per_tm = 32;   ///< thread processors (one hardware thread each) per TM
+    uint32_t tms_per_l2 = 4;    ///< TMs sharing one L2; the last group may be smaller
+    bool operator==(const ChipShape&) const = default;
+};
+
+/// [tp] One thread processor: in-order, single issue.
+struct ThreadConfig {
+    uint32_t branch_taken_penalty = 1;      ///< bubble cycles after a taken branch or jump
+    uint32_t branch_not_taken_penalty = 0;  ///< bubble cycles after a branch that falls through
+    uint32_t local_store_bytes = 4096;      ///< private local store (stack) per thread
+    uint32_t local_store_latency = 1;       ///< cycles for a load from the local store
+    bool operator==(const ThreadConfig&) const = default;
+};
+
+/// One pool of identical functional units shared by the TPs of a TM.
+struct FuConfig {
+    uint32_t count = 1;     ///< units in the pool (per TM)
+    uint32_t latency = 1;   ///< cycles from issue until the result can be read
+    bool pipelined = true;  ///< a pipelined unit accepts a new operation every cycle; otherwise
+                            ///< it is busy for `latency` cycles
+    bool operator==(const FuConfig&) const = default;
+};
+
+/// [fu.*] The functional-unit pools of one TM (TRaX: ~1 FP add and 1 FP multiply per 8
+/// threads, 1 FP divide per TM, 1 integer multiply per 16 threads).
+struct FuPoolsConfig {
+    FuConfig int_alu{32, 1, true};      ///< add, logic, shifts, compares, lui/auipc, CSR, fence
+    FuConfig int_muldiv{2, 2, true};    ///< mul*, div*, rem*
+    FuConfig fp_add{4, 2, true};        ///< fadd, fsub
+    FuConfig fp_mul{4, 2, true};        ///< fmul and the fused multiply-add family
+    FuConfig fp_divsqrt{1, 16, true};   ///< fdiv, fsqrt
+    FuConfig fp_misc{8, 1, true};       ///< compare, min/max, sign injection, move, convert
+    FuConfig branch{8, 1, true};        ///< conditional branches and jumps
+    FuConfig load_store{8, 1, true};    ///< address generation; the cache adds its own latency
+    FuConfig atomic{1, 1, true};        ///< issue slot of global-register atomics
+    bool operator==(const FuPoolsConfig&) const = default;
+};
+
+/// [icache] Instruction fetch. The I-cache never misses (as in TRaX); only bank conflicts
+/// between threads fetching in the same cycle are modelled.
+struct ICacheConfig {
+    uint32_t threads_per_icache = 16;  ///< TPs sharing one instruction cache
+    uint32_t banks = 16;               ///< banks per instruction cache, interleaved by word
+    bool operator==(const ICacheConfig&) const = default;
+};
+
+/// [l1] and [l2] A banked, set-associative (LRU), non-blocking data cache.
+struct CacheConfig {
+    uint32_t size_bytes = 32768;  ///< capacity
+    uint32_t ways = 4;            ///< associativity
+    uint32_t line_bytes = 64;     ///< line size; power of two, the same at every level
+    uint32_t banks = 8;           ///< one access per bank per cycle; bank = line number % banks
+    uint32_t hit_latency = 1;     ///< cycles from access to data on a hit
+    uint32_t mshrs = 16;          ///< outstanding missed lines; misses to one line merge
+    bool operator==(const CacheConfig&) const = default;
+};
+
+/// [dram] Channels x banks with row buffers (open-page, FR-FCFS). All times are in core cycles
+/// (a GDDR part at 2x the core clock has half its own cycle counts).
+struct DramConfig {
+    uint32_t channels = 8;        ///< independent channels, each with its own data bus
+    uint32_t banks = 16;          ///< banks per channel, each with one row buffer
+    uint32_t row_bytes = 2048;    ///< bytes per row (page) of one bank
+    uint32_t queue_depth = 32;    ///< pending requests per channel before back-pressure
+    uint32_t tRCD = 12;           ///< activate to read/write, same bank
+    uint32_t tCL = 12;            ///< read command to first data
+    uint32_t tCWL = 4;            ///< write command to first data
+    uint32_t tRP = 12;            ///< precharge to activate, same bank
+    uint32_t tRAS = 28;           ///< activate to precharge, same bank
+    uint32_t tBURST = 2;          ///< data-bus cycles to move one cache line
+    uint32_t tCCD = 2;            ///< column command to column command, same channel
+    uint32_t tRRD = 5;            ///< activate to activate, different banks of a channel
+    uint32_t tWR = 12;            ///< end of write data to precharge (write recovery)
+    uint32_t tWTR = 5;            ///< end of write data to read command (turnaround)
+    uint32_t tRTP = 4;            ///< read command to precharge
+    bool operator==(const DramConfig&) const = default;
+};
+
+/// [global_registers] The chip-wide unit serving atomic increments (work distribution).
+struct GlobalRegisterConfig {
+    uint32_t latency = 4;    ///< cycles from arrival at the unit to the reply
+    uint32_t per_cycle = 1;  ///< requests served per cycle, in (cycle, TM, sequence) order
+    uint32_t link_latency = 2;  ///< cycles each way between a TM and the unit
+    bool operator==(const GlobalRegisterConfig&) const = default;
+};
+
+/// The resolved configuration of one chip.
+struct ChipConfig {
+    ChipShape chip;
+    ThreadConfig tp;
+    FuPoolsConfig fu;
+    ICacheConfig icache;
+    CacheConfig l1;
+    CacheConfig l2{524288, 8, 64, 16, 8, 64};
+    DramConfig dram;
+    GlobalRegisterConfig global_registers;
+    bool operator==(const ChipConfig&) const = default;
+
+    /// Number of L2 caches: one per group of chip.tms_per_l2 TMs.
+    uint32_t num_l2() const { return (chip.num_tms + chip.tms_per_l2 - 1) / chip.tms_per_l2; }
+};
+
+/// Reads a TOML file over the defaults; every key is optional, unknown keys are errors.
+ChipConfig load_config(const std::string& path);
+/// Parses TOML text (`source_name` appears in error messages) over `base`.
+ChipConfig parse_config(std::string_view toml_text, std::string_view source_name,
+                        const ChipConfig& base = {});
+/// Applies one "key.path=value" override (e.g. "l1.size_bytes=16384") with full validation.
+void apply_override(ChipConfig& config, std::string_view assignment);
+/// Checks every range and cross-field rule; throws ConfigError naming the first violation.
+void validate(const ChipConfig& config);
+/// The resolved configuration as TOML, every key present, with its allowed range as a comment.
+std::string to_toml(const ChipConfig& config);
+/// Every configurable key, in print order (for help text and tests).
+std::vector<std::string> config_keys();
+
+}  // namespace tpsim::timing

@@ -1,0 +1,81 @@
+#include "timing/config.hpp"
+
+#include <catch2/catch.hpp>
+
+using namespace tpsim::timing;
+using Catch::Contains;
+
+namespace {
+const std::string kConfigs = TPSIM_CONFIG_DIR;
+}
+
+TEST_CASE("the trax preset spells out exactly the built-in defaults", "[config]") {
+    CHECK(load_config(kConfigs + "/trax.toml") == ChipConfig{});
+    CHECK_NOTHROW(validate(ChipConfig{}));
+}
+
+TEST_CASE("the tiny preset is 1 TM x 4 TPs and keeps unlisted defaults", "[config]") {
+    const ChipConfig tiny = load_config(kConfigs + "/tiny.toml");
+    CHECK(tiny.chip.num_tms == 1);
+    CHECK(tiny.chip.tps_per_tm == 4);
+    CHECK(tiny.l1.size_bytes == 1024);
+    CHECK_FALSE(tiny.fu.fp_divsqrt.pipelined);
+    CHECK(tiny.dram.tRCD == ChipConfig{}.dram.tRCD);
+    CHECK(tiny.num_l2() == 1);
+}
+
+TEST_CASE("errors name the source line, the key and the allowed range", "[config]") {
+    CHECK_THROWS_WITH(parse_config("[l1]\nsize_bytes = 32768\nways = 0\n", "x.toml"),
+                      Contains("x.toml:3") && Contains("l1.ways = 0") &&
+                          Contains("allowed 1..64"));
+    CHECK_THROWS_WITH(parse_config("[l1]\nsise_bytes = 1\n", "x.toml"),
+                      Contains("x.toml:2") && Contains("unknown key 'l1.sise_bytes'"));
+    CHECK_THROWS_WITH(parse_config("[fu.fp_add]\npipelined = 3\n", "x.toml"),
+                      Contains("fu.fp_add.pipelined must be true or false"));
+    CHECK_THROWS_WITH(parse_config("[dram]\ntCL = \"fast\"\n", "x.toml"),
+                      Contains("dram.tCL must be an integer in 1..1000"));
+    CHECK_THROWS_WITH(parse_config("[chip\n", "x.toml"), Contains("x.toml:1"));
+    CHECK_THROWS_WITH(load_config("/nonexistent/chip.toml"), Contains("/nonexistent/chip.toml"));
+}
+
+TEST_CASE("cross-field rules are checked", "[config]") {
+    CHECK_THROWS_WITH(parse_config("[l1]\nsize_bytes = 3000\n", "x.toml"),
+                      Contains("l1.size_bytes = 3000 must be a power-of-two multiple"));
+    CHECK_THROWS_WITH(parse_config("[l2]\nline_bytes = 128\n", "x.toml"),
+                      Contains("must equal l1.line_bytes"));
+    CHECK_THROWS_WITH(parse_config("[l1]\nline_bytes = 48\n", "x.toml"),
+                      Contains("power of two"));
+    CHECK_THROWS_WITH(parse_config("[dram]\ntRAS = 5\n", "x.toml"), Contains("dram.tRAS"));
+}
+
+TEST_CASE("overrides set one field with the same validation", "[config]") {
+    ChipConfig c;
+    apply_override(c, "l1.size_bytes=16384");
+    CHECK(c.l1.size_bytes == 16384);
+    apply_override(c, "fu.fp_divsqrt.pipelined = false");
+    CHECK_FALSE(c.fu.fp_divsqrt.pipelined);
+    apply_override(c, "chip.num_tms=0x10");
+    CHECK(c.chip.num_tms == 16);
+    const ChipConfig before = c;
+    CHECK_THROWS_WITH(apply_override(c, "l1.ways=65"),
+                      Contains("override 'l1.ways=65'") && Contains("allowed 1..64"));
+    CHECK_THROWS_WITH(apply_override(c, "l1.ways"), Contains("expected key=value"));
+    CHECK_THROWS_WITH(apply_override(c, "l1.wayz=2"), Contains("unknown key 'l1.wayz'"));
+    CHECK_THROWS_WITH(apply_override(c, "l1.ways=two"), Contains("must be an integer"));
+    CHECK_THROWS_WITH(apply_override(c, "l1.ways=-1"), Contains("out of range"));
+    CHECK_THROWS_WITH(apply_override(c, "l1.size_bytes=1000"), Contains("power-of-two"));
+    CHECK(c == before);  // a rejected override leaves the config untouched
+}
+
+TEST_CASE("the printed config lists every key and parses back to the same config", "[config]") {
+    ChipConfig c;
+    apply_override(c, "dram.tCL=20");
+    apply_override(c, "fu.atomic.pipelined=false");
+    const std::string text = to_toml(c);
+    for (const std::string& key : config_keys()) {
+        const std::string leaf = key.substr(key.rfind('.') + 1);
+        CHECK(text.find(leaf) != std::string::npos);
+    }
+    CHECK(parse_config(text, "printed") == c);
+    CHECK(config_keys().size() == 4 + 4 + 9 * 3 + 2 + 2 * 6 + 15 + 3);
+}
