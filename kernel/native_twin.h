@@ -1,0 +1,34 @@
+/* The native twin's entry point: every kernel also builds as libNAME_native.so exporting
+ * tpsim_native_run(), which the simulator (or a test) dlopen()s to render the same image on the
+ * host. Plain C so any host code can call it. See docs/kernel-api.md. */
+#ifndef TPSIM_KERNEL_NATIVE_TWIN_H
+#define TPSIM_KERNEL_NATIVE_TWIN_H
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Everything the twin needs to run a kernel over a memory image. */
+typedef struct TraxNativeContext {
+    uint32_t* global_words;     /**< global memory: word 0 is at guest address kGlobalBase */
+    uint32_t global_word_count; /**< accesses at or past this word are reported as errors */
+    uint32_t num_threads;       /**< trax_main() runs once per thread id, in order 0..n-1 */
+    uint32_t num_tms;           /**< thread i is in TM i / tm_size, at index i % tm_size */
+    uint32_t tm_size;
+    char* error;                /**< receives a one-line message when the run fails */
+    uint32_t error_capacity;    /**< bytes at error, including the terminating NUL */
+} TraxNativeContext;
+
+/** Runs the kernel; global registers start at 0. Returns 0 on success, nonzero after writing
+ * the reason (bad memory access, bad atomic register, bad context) to ctx->error. */
+int tpsim_native_run(const TraxNativeContext* ctx);
+
+/** The symbol name, for dlsym(). */
+#define TPSIM_NATIVE_RUN_SYMBOL "tpsim_native_run"
+typedef int (*TpsimNativeRunFn)(const TraxNativeContext*);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,194 @@
+// The TRaX kernel API (CS 6958 style): global memory in 32-bit words, atomics, thread ids, scene
+// accessors and float helpers. One header, two implementations:
+//   __riscv  : inline asm on the simulated RV32IMF machine, no call overhead;
+//   otherwise: the "native twin", the same functions over the context tpsim_native_run() sets up,
+//              with bounds checks that report a bad access instead of crashing.
+// A kernel defines `void trax_main()`; every hardware thread runs it once. docs/kernel-api.md.
+#pragma once
+#include <stdint.h>
+
+#include "memory_map.hpp"
+#include "scene_layout.hpp"
+
+/// The kernel's entry point, written by the student; run once by every thread.
+/// extern "C" so the start-up code can call it by its plain name; a definition after this
+/// declaration inherits the C linkage.
+extern "C" void trax_main();
+
+#if defined(__riscv)
+
+#define TRAX_INLINE inline __attribute__((always_inline))
+
+namespace trax::detail {
+/// Byte address of global word (addr + offset). The word grid starts at kGlobalBase.
+TRAX_INLINE uint32_t global_byte_address(int addr, int offset) {
+    return map::kGlobalBase + static_cast<uint32_t>(addr + offset) * 4u;
+}
+}  // namespace trax::detail
+
+// The "m" operands tell the compiler exactly which word is touched, so it may fold constant
+// offsets into the instruction's immediate and order loads around stores correctly. Loads are
+// not volatile: re-reading the same word may be merged, as with any memory read.
+TRAX_INLINE float loadf(int addr, int offset = 0) {
+    float value;
+    const float* p = reinterpret_cast<const float*>(trax::detail::global_byte_address(addr, offset));
+    asm("flw %0, %1" : "=f"(value) : "m"(*p));
+    return value;
+}
+
+TRAX_INLINE int loadi(int addr, int offset = 0) {
+    int value;
+    const int* p = reinterpret_cast<const int*>(trax::detail::global_byte_address(addr, offset));
+    asm("lw %0, %1" : "=r"(value) : "m"(*p));
+    return value;
+}
+
+TRAX_INLINE void storef(float value, int addr, int offset = 0) {
+    float* p = reinterpret_cast<float*>(trax::detail::global_byte_address(addr, offset));
+    asm volatile("fsw %1, %0" : "=m"(*p) : "f"(value));
+}
+
+TRAX_INLINE void storei(int value, int addr, int offset = 0) {
+    int* p = reinterpret_cast<int*>(trax::detail::global_byte_address(addr, offset));
+    asm volatile("sw %1, %0" : "=m"(*p) : "r"(value));
+}
+
+/// Returns the old value of global register `reg` (0..255) and increments it, atomically over
+/// all threads. `reg` must be a compile-time constant: it is the instruction's immediate.
+TRAX_INLINE int atomicinc(int reg) {
+    int old;
+    asm volatile(".insn i 0x0b, 0, %0, x0, %1" : "=r"(old) : "i"(reg) : "memory");
+    return old;
+}
+
+// Thread ids come from CSRs: mhartid (standard) and the read-only custom CSRs 0xCC0..0xCC4.
+// Not volatile: they never change while a thread runs, so repeated reads may be merged.
+#define TRAX_CSR_FUNCTION(name, csr)                  \
+    TRAX_INLINE int name() {                          \
+        int value;                                    \
+        asm("csrr %0, " #csr : "=r"(value));          \
+        return value;                                 \
+    }
+TRAX_CSR_FUNCTION(trax_thread_id, mhartid)
+TRAX_CSR_FUNCTION(trax_num_threads, 0xCC0)
+TRAX_CSR_FUNCTION(trax_tm_id, 0xCC1)
+TRAX_CSR_FUNCTION(trax_num_tms, 0xCC2)
+TRAX_CSR_FUNCTION(trax_tp_id, 0xCC3)
+TRAX_CSR_FUNCTION(trax_tm_size, 0xCC4)
+#undef TRAX_CSR_FUNCTION
+
+#else  // the native twin
+
+#include <stdexcept>
+#include <string>
+
+#define TRAX_INLINE inline
+
+namespace trax::native {
+
+/// What the kernel API sees while the twin runs one thread. Set by tpsim_native_run().
+struct ThreadContext {
+    uint32_t* words = nullptr;  ///< global memory, word 0 at kGlobalBase
+    int64_t word_count = 0;
+    uint32_t* global_registers = nullptr;  ///< kGlobalRegisters of them, all 0 at start
+    int thread_id = 0, num_threads = 0, tm_id = 0, num_tms = 0, tp_id = 0, tm_size = 0;
+};
+constexpr int kGlobalRegisters = 256;
+
+/// The thread the twin is running now. One per loaded twin library (hidden visibility);
+/// tpsim_native_run() serialises calls so concurrent runs cannot share it.
+inline ThreadContext* current = nullptr;
+
+/// A kernel mistake the twin caught; tpsim_native_run() turns it into its error message.
+struct KernelFault : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+inline uint32_t& word(const char* api, int addr, int offset) {
+    const int64_t index = int64_t{addr} + offset;
+    if (index < 0 || index >= current->word_count)
+        throw KernelFault(std::string(api) + "(addr=" + std::to_string(addr) +
+                          ", offset=" + std::to_string(offset) + ") in thread " +
+                          std::to_string(current->thread_id) + ": word " + std::to_string(index) +
+                          " is outside global memory [0, " + std::to_string(current->word_count) +
+                          ") — check the address arithmetic");
+    return current->words[index];
+}
+
+}  // namespace trax::native
+
+inline float loadf(int addr, int offset = 0) {
+    return __builtin_bit_cast(float, trax::native::word("loadf", addr, offset));
+}
+inline int loadi(int addr, int offset = 0) {
+    return static_cast<int>(trax::native::word("loadi", addr, offset));
+}
+inline void storef(float value, int addr, int offset = 0) {
+    trax::native::word("storef", addr, offset) = __builtin_bit_cast(uint32_t, value);
+}
+inline void storei(int value, int addr, int offset = 0) {
+    trax::native::word("storei", addr, offset) = static_cast<uint32_t>(value);
+}
+inline int atomicinc(int reg) {
+    using trax::native::current;
+    if (reg < 0 || reg >= trax::native::kGlobalRegisters)
+        throw trax::native::KernelFault("atomicinc(" + std::to_string(reg) + ") in thread " +
+                                        std::to_string(current->thread_id) +
+                                        ": global registers are 0..255");
+    return static_cast<int>(current->global_registers[reg]++);
+}
+inline int trax_thread_id() { return trax::native::current->thread_id; }
+inline int trax_num_threads() { return trax::native::current->num_threads; }
+inline int trax_tm_id() { return trax::native::current->tm_id; }
+inline int trax_num_tms() { return trax::native::current->num_tms; }
+inline int trax_tp_id() { return trax::native::current->tp_id; }
+inline int trax_tm_size() { return trax::native::current->tm_size; }
+
+#endif
+
+// ---- Both sides from here on: written only in terms of the primitives above. ----------------
+
+// Scene accessors: read the scene header (trax/scene_layout.hpp) at word 0.
+TRAX_INLINE int trax_image_width() { return loadi(0, trax::layout::kHeaderImageWidth); }
+TRAX_INLINE int trax_image_height() { return loadi(0, trax::layout::kHeaderImageHeight); }
+TRAX_INLINE int trax_samples_per_pixel() { return loadi(0, trax::layout::kHeaderSamplesPerPixel); }
+TRAX_INLINE int trax_scene_flags() { return loadi(0, trax::layout::kHeaderFlags); }
+/// Word address of the ambient (3 floats) and background (3 floats) colours.
+TRAX_INLINE int trax_ambient() { return trax::layout::kHeaderAmbient; }
+TRAX_INLINE int trax_background() { return trax::layout::kHeaderBackground; }
+// Section word addresses and record counts.
+TRAX_INLINE int trax_camera() { return loadi(0, trax::layout::kHeaderCamera); }
+TRAX_INLINE int trax_lights() { return loadi(0, trax::layout::kHeaderLights); }
+TRAX_INLINE int trax_num_lights() { return loadi(0, trax::layout::kHeaderLights + 1); }
+TRAX_INLINE int trax_materials() { return loadi(0, trax::layout::kHeaderMaterials); }
+TRAX_INLINE int trax_num_materials() { return loadi(0, trax::layout::kHeaderMaterials + 1); }
+TRAX_INLINE int trax_triangles() { return loadi(0, trax::layout::kHeaderTriangles); }
+TRAX_INLINE int trax_num_triangles() { return loadi(0, trax::layout::kHeaderTriangles + 1); }
+TRAX_INLINE int trax_bvh() { return loadi(0, trax::layout::kHeaderBvhNodes); }
+TRAX_INLINE int trax_num_bvh_nodes() { return loadi(0, trax::layout::kHeaderBvhNodes + 1); }
+TRAX_INLINE int trax_framebuffer() { return loadi(0, trax::layout::kHeaderFramebuffer); }
+
+// Float helpers that give the same bits on both sides: IEEE operations only, no libm.
+/// Correctly rounded square root: fsqrt.s on the guest, sqrtss on x86-64.
+TRAX_INLINE float trax_sqrt(float x) { return __builtin_sqrtf(x); }
+TRAX_INLINE float trax_abs(float x) { return __builtin_fabsf(x); }
+// Comparisons rather than fmin/fmax: the two ISAs disagree on NaN operands, a compare does not.
+TRAX_INLINE float trax_min(float a, float b) { return a < b ? a : b; }
+TRAX_INLINE float trax_max(float a, float b) { return a > b ? a : b; }
+
+// Course (simtrax) names, so CS 6958 starter code compiles unchanged where the meaning matches.
+TRAX_INLINE int GetXRes() { return trax_image_width(); }
+TRAX_INLINE int GetYRes() { return trax_image_height(); }
+TRAX_INLINE int GetFrameBuffer() { return trax_framebuffer(); }
+TRAX_INLINE int GetCamera() { return trax_camera(); }
+TRAX_INLINE int GetMaterials() { return trax_materials(); }
+TRAX_INLINE int GetStartTriangles() { return trax_triangles(); }
+TRAX_INLINE int GetNumTriangles() { return trax_num_triangles(); }
+TRAX_INLINE int GetLight() { return trax_lights(); }
+TRAX_INLINE int GetNumLights() { return trax_num_lights(); }
+TRAX_INLINE int GetBVH() { return trax_bvh(); }
+TRAX_INLINE float min(float a, float b) { return trax_min(a, b); }
+TRAX_INLINE float max(float a, float b) { return trax_max(a, b); }
+TRAX_INLINE float invsqrt(float x) { return 1.0f / trax_sqrt(x); }
+
+#undef TRAX_INLINE
