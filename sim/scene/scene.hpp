@@ -24,11 +24,20 @@ struct PointLight {
     glm::vec3 color{1.f};  ///< radiant intensity per channel
 };
 
+/// Right-handed: the image's right axis is normalize(cross(look_at - eye, up)).
 struct Camera {
     glm::vec3 eye{0.f, 0.f, 1.f};
     glm::vec3 look_at{0.f};
     glm::vec3 up{0.f, 1.f, 0.f};
     float vertical_fov_degrees = 45.f;
+};
+
+/// What one mesh file or generator contributed, so the caller can print an import summary.
+struct SourceSummary {
+    std::string source;                   ///< mesh path or "generator <type>"
+    uint64_t triangles = 0;               ///< triangles added to Scene::triangles
+    uint64_t degenerate_triangles = 0;    ///< of those, with zero area (kept on purpose)
+    uint64_t skipped_primitives = 0;      ///< points and lines in the file, not imported
 };
 
 struct Scene {
@@ -41,6 +50,7 @@ struct Scene {
     glm::vec3 background{0.f};
     uint32_t width = 256, height = 256;
     uint32_t samples_per_pixel = 1;
+    std::vector<SourceSummary> sources;  ///< in the order they were loaded
 };
 
 }  // namespace tpsim::scene

@@ -1,0 +1,408 @@
+#include "bvh.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+namespace tpsim::scene {
+
+float Aabb::surface_area() const {
+    const glm::vec3 d = glm::max(hi - lo, glm::vec3(0.f));
+    return 2.f * (d.x * d.y + d.y * d.z + d.z * d.x);
+}
+
+bool Aabb::contains(const Aabb& inner) const {
+    return glm::all(glm::lessThanEqual(lo, inner.lo)) && glm::all(glm::lessThanEqual(inner.hi, hi));
+}
+
+const char* to_string(BvhBuilder builder) {
+    return builder == BvhBuilder::binned ? "binned" : "sweep";
+}
+
+namespace {
+
+/// A box that starts empty and grows; converted to Aabb only once it holds something.
+struct Box {
+    glm::vec3 lo{std::numeric_limits<float>::infinity()};
+    glm::vec3 hi{-std::numeric_limits<float>::infinity()};
+    void grow(const Box& b) {
+        lo = glm::min(lo, b.lo);
+        hi = glm::max(hi, b.hi);
+    }
+    void grow(const glm::vec3& p) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    }
+    float area() const { return Aabb{lo, hi}.surface_area(); }
+};
+
+/// Most triangles a subtree can hold when its leaves may sit at most `levels` below its root.
+uint64_t subtree_capacity(uint32_t max_leaf_size, uint32_t levels) {
+    return levels >= 40 ? std::numeric_limits<uint64_t>::max() / 2 : uint64_t{max_leaf_size} << levels;
+}
+
+/// A candidate object split: the first `left_count` triangles of the node's order go left.
+/// cost = A(left) * n_left + A(right) * n_right, i.e. the SAH without the node's own term.
+struct Split {
+    int axis = -1;
+    uint32_t left_count = 0;
+    double cost = std::numeric_limits<double>::infinity();
+    bool valid() const { return axis >= 0; }
+};
+
+/// Shared by both builders: per-triangle boxes and centroids, node emission and the
+/// leaf-or-split decision, which is where the SAH and the depth limit meet.
+class BuilderBase {
+public:
+    BuilderBase(std::span<const Triangle> triangles, const BvhConfig& config) : config_(config) {
+        boxes_.resize(triangles.size());
+        centroids_.resize(triangles.size());
+        for (size_t i = 0; i < triangles.size(); ++i) {
+            const Triangle& t = triangles[i];
+            Box b;
+            b.grow(t.v0);
+            b.grow(t.v1);
+            b.grow(t.v2);
+            boxes_[i] = b;
+            centroids_[i] = (b.lo + b.hi) * 0.5f;
+        }
+    }
+
+protected:
+    struct NodeChoice {
+        bool make_leaf = false;
+        Split split;
+    };
+
+    /// `best` ignores the depth limit, `feasible` honours it (both sides fit below the limit).
+    NodeChoice decide(uint32_t count, float node_area, uint32_t levels_left, const Split& best,
+                      const Split& feasible) {
+        const bool fits_leaf = count <= config_.max_leaf_size;
+        if (levels_left == 0) {
+            if (best.valid() && best.cost + node_area < double(count) * node_area) ++stats_.depth_limited_nodes;
+            return {true, {}};
+        }
+        if (fits_leaf && (!feasible.valid() || double(count) * node_area <= node_area + feasible.cost))
+            return {true, {}};
+        if (best.valid() && (!feasible.valid() || feasible.cost > best.cost)) ++stats_.depth_limited_nodes;
+        return {false, feasible};
+    }
+
+    uint32_t emit_node(const Box& bounds) {
+        nodes_.push_back(BvhNode{Aabb{bounds.lo, bounds.hi}, 0, 0, 0});
+        return uint32_t(nodes_.size() - 1);
+    }
+
+    /// Most triangles each child may take; 0 at the depth limit, where no split is feasible.
+    uint64_t child_capacity(uint32_t levels_left) const {
+        return levels_left == 0 ? 0 : subtree_capacity(config_.max_leaf_size, levels_left - 1);
+    }
+
+    const BvhConfig& config_;
+    std::vector<Box> boxes_;
+    std::vector<glm::vec3> centroids_;
+    std::vector<BvhNode> nodes_;
+    BvhStats stats_;
+};
+
+/// Exact SAH over object splits: the triangles of every node are kept sorted by centroid on
+/// each axis (three index lists, presorted once, partitioned stably per node), and every split
+/// position on every axis is evaluated: O(n log n) presort + O(n) per tree level.
+class SweepBuilder : BuilderBase {
+public:
+    SweepBuilder(std::span<const Triangle> triangles, const BvhConfig& config)
+        : BuilderBase(triangles, config) {
+        const uint32_t n = uint32_t(triangles.size());
+        for (int axis = 0; axis < 3; ++axis) {
+            auto& order = order_[axis];
+            order.resize(n);
+            for (uint32_t i = 0; i < n; ++i) order[i] = i;
+            // Index tie-break makes the order (and so the tree) independent of the sort algorithm.
+            std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+                const float ca = centroids_[a][axis], cb = centroids_[b][axis];
+                return ca < cb || (ca == cb && a < b);
+            });
+        }
+        right_area_.resize(n);
+        goes_right_.resize(n);
+        scratch_.resize(n);
+    }
+
+    Bvh build() {
+        nodes_.reserve(2 * order_[0].size());
+        build_node(0, uint32_t(order_[0].size()), config_.traversal_stack_entries);
+        return Bvh{std::move(nodes_), std::move(order_[0]), std::move(stats_)};
+    }
+
+private:
+    void build_node(uint32_t begin, uint32_t end, uint32_t levels_left) {
+        const uint32_t count = end - begin;
+        Box bounds;
+        for (uint32_t i = begin; i < end; ++i) bounds.grow(boxes_[order_[0][i]]);
+        const uint32_t index = emit_node(bounds);
+
+        Split best, feasible;
+        if (count > 1) find_splits(begin, end, child_capacity(levels_left), best, feasible);
+        const NodeChoice choice = decide(count, bounds.area(), levels_left, best, feasible);
+        if (choice.make_leaf) {
+            nodes_[index].first_triangle = begin;
+            nodes_[index].triangle_count = count;
+            return;
+        }
+        partition(begin, end, choice.split);
+        const uint32_t middle = begin + choice.split.left_count;
+        build_node(begin, middle, levels_left - 1);
+        nodes_[index].right_child = uint32_t(nodes_.size());
+        build_node(middle, end, levels_left - 1);
+    }
+
+    void find_splits(uint32_t begin, uint32_t end, uint64_t child_cap, Split& best, Split& feasible) {
+        const uint32_t count = end - begin;
+        for (int axis = 0; axis < 3; ++axis) {
+            const auto& order = order_[axis];
+            Box right;
+            for (uint32_t i = end - 1; i > begin; --i) {
+                right.grow(boxes_[order[i]]);
+                right_area_[i] = right.area();
+            }
+            Box left;
+            for (uint32_t i = begin; i + 1 < end; ++i) {
+                left.grow(boxes_[order[i]]);
+                const uint32_t left_count = i + 1 - begin, right_count = count - left_count;
+                const double cost = double(left.area()) * left_count + double(right_area_[i + 1]) * right_count;
+                // Strict '<' keeps the first axis and leftmost position on ties: deterministic.
+                if (cost < best.cost) best = {axis, left_count, cost};
+                if (cost < feasible.cost && left_count <= child_cap && right_count <= child_cap)
+                    feasible = {axis, left_count, cost};
+            }
+        }
+    }
+
+    /// Splits the range on the chosen axis and carries the split over to the other two sorted
+    /// lists with a stable partition, so they stay sorted.
+    void partition(uint32_t begin, uint32_t end, const Split& split) {
+        const uint32_t middle = begin + split.left_count;
+        const auto& chosen = order_[split.axis];
+        for (uint32_t i = begin; i < end; ++i) goes_right_[chosen[i]] = i >= middle;
+        for (int axis = 0; axis < 3; ++axis) {
+            if (axis == split.axis) continue;
+            auto& order = order_[axis];
+            uint32_t left = begin, right = 0;
+            for (uint32_t i = begin; i < end; ++i) {
+                const uint32_t t = order[i];
+                if (goes_right_[t]) scratch_[right++] = t;
+                else order[left++] = t;
+            }
+            std::copy(scratch_.begin(), scratch_.begin() + right, order.begin() + left);
+        }
+    }
+
+    std::vector<uint32_t> order_[3];
+    std::vector<float> right_area_;   // right_area_[i]: area of the range's suffix from i
+    std::vector<uint8_t> goes_right_;  // per triangle, for the current partition
+    std::vector<uint32_t> scratch_;
+};
+
+/// Binned SAH after Wald 2007: centroids are binned into `bins` equal slots per axis and only
+/// the bin boundaries are evaluated: O(n) per tree level, no sorting.
+class BinnedBuilder : BuilderBase {
+public:
+    BinnedBuilder(std::span<const Triangle> triangles, const BvhConfig& config)
+        : BuilderBase(triangles, config), bins_(config.bins) {
+        sweep_.bins.resize(bins_);
+        sweep_.right_area.resize(bins_);
+        sweep_.right_count.resize(bins_);
+        order_.resize(triangles.size());
+        for (uint32_t i = 0; i < order_.size(); ++i) order_[i] = i;
+    }
+
+    Bvh build() {
+        nodes_.reserve(2 * order_.size());
+        build_node(0, uint32_t(order_.size()), config_.traversal_stack_entries);
+        return Bvh{std::move(nodes_), std::move(order_), std::move(stats_)};
+    }
+
+private:
+    struct Bin {
+        Box bounds;
+        uint32_t count = 0;
+    };
+    struct BinSweep {
+        std::vector<Bin> bins;
+        std::vector<float> right_area;      // [b]: area of bins b.. together
+        std::vector<uint32_t> right_count;  // [b]: triangles in bins b..
+    };
+
+    void build_node(uint32_t begin, uint32_t end, uint32_t levels_left) {
+        const uint32_t count = end - begin;
+        Box bounds, centroid_bounds;
+        for (uint32_t i = begin; i < end; ++i) {
+            bounds.grow(boxes_[order_[i]]);
+            centroid_bounds.grow(centroids_[order_[i]]);
+        }
+        const uint32_t index = emit_node(bounds);
+
+        Split best, feasible;
+        if (count > 1) find_splits(begin, end, centroid_bounds, child_capacity(levels_left), best, feasible);
+        NodeChoice choice = decide(count, bounds.area(), levels_left, best, feasible);
+        if (!choice.make_leaf && !choice.split.valid() && count <= config_.max_leaf_size) choice.make_leaf = true;
+        if (choice.make_leaf) {
+            nodes_[index].first_triangle = begin;
+            nodes_[index].triangle_count = count;
+            return;
+        }
+        const uint32_t middle = choice.split.valid() ? partition_by_bin(begin, end, centroid_bounds, choice.split)
+                                                     : partition_at_median(begin, end, centroid_bounds);
+        build_node(begin, middle, levels_left - 1);
+        nodes_[index].right_child = uint32_t(nodes_.size());
+        build_node(middle, end, levels_left - 1);
+    }
+
+    /// Bins per unit length on an axis, or 0 when the centroids cannot be binned along it.
+    float bin_scale(int axis, const Box& centroid_bounds) const {
+        const float scale = float(bins_) / (centroid_bounds.hi[axis] - centroid_bounds.lo[axis]);
+        return centroid_bounds.hi[axis] > centroid_bounds.lo[axis] && std::isfinite(scale) ? scale : 0.f;
+    }
+
+    uint32_t bin_of(uint32_t triangle, int axis, const Box& centroid_bounds, float scale) const {
+        const float slot = (centroids_[triangle][axis] - centroid_bounds.lo[axis]) * scale;
+        return uint32_t(std::clamp(slot, 0.f, float(bins_ - 1)));
+    }
+
+    /// Split.left_count holds the number of bins that go left (the split is after that bin).
+    void find_splits(uint32_t begin, uint32_t end, const Box& centroid_bounds, uint64_t child_cap, Split& best,
+                     Split& feasible) {
+        auto& [bins, right_area, right_count] = sweep_;
+        for (int axis = 0; axis < 3; ++axis) {
+            const float scale = bin_scale(axis, centroid_bounds);
+            if (scale == 0.f) continue;
+            std::fill(bins.begin(), bins.end(), Bin{});
+            for (uint32_t i = begin; i < end; ++i) {
+                Bin& bin = bins[bin_of(order_[i], axis, centroid_bounds, scale)];
+                bin.bounds.grow(boxes_[order_[i]]);
+                ++bin.count;
+            }
+            Box right;
+            uint32_t right_n = 0;
+            for (uint32_t b = bins_ - 1; b > 0; --b) {
+                right.grow(bins[b].bounds);
+                right_n += bins[b].count;
+                right_area[b] = right.area();
+                right_count[b] = right_n;
+            }
+            Box left;
+            uint32_t left_n = 0;
+            for (uint32_t b = 0; b + 1 < bins_; ++b) {
+                left.grow(bins[b].bounds);
+                left_n += bins[b].count;
+                const uint32_t right_n_here = right_count[b + 1];
+                if (left_n == 0 || right_n_here == 0) continue;
+                const double cost = double(left.area()) * left_n + double(right_area[b + 1]) * right_n_here;
+                if (cost < best.cost) best = {axis, b + 1, cost};
+                if (cost < feasible.cost && left_n <= child_cap && right_n_here <= child_cap)
+                    feasible = {axis, b + 1, cost};
+            }
+        }
+    }
+
+    uint32_t partition_by_bin(uint32_t begin, uint32_t end, const Box& centroid_bounds, const Split& split) {
+        const float scale = bin_scale(split.axis, centroid_bounds);
+        // std::partition is not stable but is a pure function of its input: still deterministic.
+        const auto middle = std::partition(order_.begin() + begin, order_.begin() + end, [&](uint32_t t) {
+            return bin_of(t, split.axis, centroid_bounds, scale) < split.left_count;
+        });
+        return uint32_t(middle - order_.begin());
+    }
+
+    /// Fallback when binning cannot separate the triangles within the depth limit (e.g. all
+    /// centroids in one bin): half the triangles by centroid on the widest axis.
+    uint32_t partition_at_median(uint32_t begin, uint32_t end, const Box& centroid_bounds) {
+        const glm::vec3 extent = centroid_bounds.hi - centroid_bounds.lo;
+        const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
+        const uint32_t middle = begin + (end - begin) / 2;
+        std::nth_element(order_.begin() + begin, order_.begin() + middle, order_.begin() + end,
+                         [&](uint32_t a, uint32_t b) {
+                             const float ca = centroids_[a][axis], cb = centroids_[b][axis];
+                             return ca < cb || (ca == cb && a < b);
+                         });
+        return middle;
+    }
+
+    uint32_t bins_;
+    std::vector<uint32_t> order_;
+    BinSweep sweep_;  // reused by every node
+};
+
+void validate(std::span<const Triangle> triangles, const BvhConfig& config) {
+    if (config.max_leaf_size < 1 || config.max_leaf_size > 8)
+        throw std::invalid_argument(fmt::format("BVH: max_leaf_size must be in 1..8, got {}", config.max_leaf_size));
+    if (config.bins < 2 || config.bins > 256)
+        throw std::invalid_argument(fmt::format("BVH: bins must be in 2..256, got {}", config.bins));
+    if (triangles.empty()) throw std::invalid_argument("BVH: the scene has no triangles; add a mesh or generator");
+    if (triangles.size() > (size_t{1} << 31))
+        throw std::invalid_argument(fmt::format("BVH: {} triangles exceed the 2^31 limit", triangles.size()));
+    const uint64_t capacity = subtree_capacity(config.max_leaf_size, config.traversal_stack_entries);
+    if (triangles.size() > capacity)
+        throw std::invalid_argument(fmt::format(
+            "BVH: {} triangles cannot fit in leaves of {} at depth <= {}; raise traversal_stack_entries",
+            triangles.size(), config.max_leaf_size, config.traversal_stack_entries));
+    for (size_t i = 0; i < triangles.size(); ++i) {
+        const Triangle& t = triangles[i];
+        for (const glm::vec3& v : {t.v0, t.v1, t.v2})
+            if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+                throw std::invalid_argument(
+                    fmt::format("BVH: triangle {} has a non-finite vertex ({}, {}, {})", i, v.x, v.y, v.z));
+    }
+}
+
+void fill_shape_stats(const Bvh& bvh, uint32_t max_leaf_size, BvhStats& stats) {
+    stats.nodes = uint32_t(bvh.nodes.size());
+    stats.leaves = 0;
+    stats.max_depth = 0;
+    stats.leaf_size_histogram.assign(max_leaf_size + 1, 0);
+    std::vector<std::pair<uint32_t, uint32_t>> pending{{0, 0}};  // (node, depth)
+    while (!pending.empty()) {
+        const auto [index, depth] = pending.back();
+        pending.pop_back();
+        const BvhNode& node = bvh.nodes[index];
+        if (node.is_leaf()) {
+            ++stats.leaves;
+            stats.max_depth = std::max(stats.max_depth, depth);
+            ++stats.leaf_size_histogram[node.triangle_count];
+        } else {
+            pending.push_back({node.right_child, depth + 1});
+            pending.push_back({index + 1, depth + 1});
+        }
+    }
+    stats.sah_cost = sah_cost(bvh);
+}
+
+}  // namespace
+
+double sah_cost(const Bvh& bvh) {
+    const double root_area = bvh.nodes.at(0).bounds.surface_area();
+    // A root without area (all triangles on one line or point) makes every ratio 0/0; take its
+    // limit, 1, so the cost still counts nodes and triangle tests.
+    const auto ratio = [&](const BvhNode& node) {
+        return root_area > 0.0 ? double(node.bounds.surface_area()) / root_area : 1.0;
+    };
+    double sum = 0.0;
+    for (const BvhNode& node : bvh.nodes) sum += ratio(node) * (node.is_leaf() ? double(node.triangle_count) : 1.0);
+    return sum;
+}
+
+Bvh build_bvh(std::span<const Triangle> triangles, const BvhConfig& config) {
+    validate(triangles, config);
+    const auto start = std::chrono::steady_clock::now();
+    Bvh bvh = config.builder == BvhBuilder::sweep ? SweepBuilder(triangles, config).build()
+                                                  : BinnedBuilder(triangles, config).build();
+    bvh.stats.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    fill_shape_stats(bvh, config.max_leaf_size, bvh.stats);
+    return bvh;
+}
+
+}  // namespace tpsim::scene
