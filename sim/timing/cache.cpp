@@ -1,0 +1,161 @@
+#include "cache.hpp"
+
+#include <fmt/format.h>
+
+#include <stdexcept>
+
+namespace tpsim::timing {
+
+Cache::Cache(const CacheConfig& config)
+    : config_(config),
+      num_sets_(config.size_bytes / (config.ways * config.line_bytes)),
+      ways_(size_t{num_sets_} * config.ways),
+      mshrs_(config.mshrs),
+      bank_used_at_(config.banks, UINT64_MAX) {
+    if (num_sets_ == 0 || (config.line_bytes & (config.line_bytes - 1)) != 0)
+        throw std::invalid_argument(
+            "Cache: invalid geometry; validate the ChipConfig before building caches");
+}
+
+Cache::Way* Cache::find(uint32_t line) {
+    Way* set = &ways_[size_t{set_of(line)} * config_.ways];
+    for (uint32_t w = 0; w < config_.ways; ++w)
+        if (set[w].valid && set[w].line == line) return &set[w];
+    return nullptr;
+}
+
+const Cache::Way* Cache::find(uint32_t line) const {
+    return const_cast<Cache*>(this)->find(line);
+}
+
+bool Cache::contains(uint32_t addr) const { return find(line_of(addr)) != nullptr; }
+
+uint32_t Cache::outstanding_misses() const {
+    uint32_t n = 0;
+    for (const Mshr& m : mshrs_) n += m.busy;
+    return n;
+}
+
+CacheOutcome Cache::access(uint64_t now, const MemRequest& request) {
+    uint64_t& bank_used = bank_used_at_[bank_of(request.addr)];
+    if (bank_used == now) {
+        ++counters_.bank_conflicts;
+        return CacheOutcome::BankConflict;
+    }
+    const uint32_t line = line_of(request.addr);
+    const uint64_t after_lookup = now + config_.hit_latency;
+
+    if (request.write) {
+        bank_used = now;
+        ++counters_.writes;
+        if (Way* way = find(line)) way->last_use = ++use_clock_;
+        outbound_.push_back({after_lookup, request});
+        return CacheOutcome::WriteForward;
+    }
+    if (Way* way = find(line)) {
+        bank_used = now;
+        ++counters_.reads;
+        ++counters_.hits;
+        way->last_use = ++use_clock_;
+        replies_.push_back({after_lookup, request});
+        return CacheOutcome::Hit;
+    }
+    Mshr* free_mshr = nullptr;
+    for (Mshr& m : mshrs_) {
+        if (m.busy && m.line == line) {
+            bank_used = now;
+            ++counters_.reads;
+            ++counters_.merged_misses;
+            m.waiters.push_back(request);
+            return CacheOutcome::MergedMiss;
+        }
+        if (!m.busy && !free_mshr) free_mshr = &m;
+    }
+    if (!free_mshr) {
+        ++counters_.mshr_full;
+        return CacheOutcome::MshrFull;
+    }
+    bank_used = now;
+    ++counters_.reads;
+    ++counters_.misses;
+    free_mshr->busy = true;
+    free_mshr->line = line;
+    free_mshr->waiters.assign(1, request);
+    MemRequest line_request = request;
+    line_request.addr = line;
+    outbound_.push_back({after_lookup, line_request});
+    return CacheOutcome::Miss;
+}
+
+void Cache::fill(uint64_t now, uint32_t line_addr) {
+    const uint32_t line = line_of(line_addr);
+    if (!find(line)) {
+        Way* set = &ways_[size_t{set_of(line)} * config_.ways];
+        Way* victim = &set[0];
+        for (uint32_t w = 0; w < config_.ways; ++w) {
+            if (!set[w].valid) {
+                victim = &set[w];
+                break;
+            }
+            if (set[w].last_use < victim->last_use) victim = &set[w];
+        }
+        counters_.evictions += victim->valid;
+        *victim = {line, true, ++use_clock_};
+    }
+    for (Mshr& m : mshrs_) {
+        if (!m.busy || m.line != line) continue;
+        for (const MemRequest& waiter : m.waiters) replies_.push_back({now + config_.hit_latency, waiter});
+        m.waiters.clear();
+        m.busy = false;
+    }
+}
+
+bool Cache::pop_reply(uint64_t now, MemReply& reply) {
+    if (replies_.empty() || replies_.front().ready > now) return false;
+    reply = replies_.front();
+    replies_.pop_front();
+    return true;
+}
+
+void Cache::register_stats(stats::Registry& r, std::string_view prefix) const {
+    auto name = [&](std::string_view leaf) { return fmt::format("{}/{}", prefix, leaf); };
+    r.add_counter(name("reads"), counters_.reads, "loads accepted", "accesses");
+    r.add_counter(name("writes"), counters_.writes, "stores accepted (write-around)", "accesses");
+    r.add_counter(name("hits"), counters_.hits, "loads that hit", "accesses");
+    r.add_counter(name("misses"), counters_.misses, "loads that requested a line below",
+                  "accesses");
+    r.add_counter(name("merged_misses"), counters_.merged_misses,
+                  "loads merged into an outstanding miss (MSHR hit)", "accesses");
+    r.add_counter(name("bank_conflicts"), counters_.bank_conflicts,
+                  "accesses refused because their bank was busy", "accesses");
+    r.add_counter(name("mshr_full"), counters_.mshr_full, "loads refused for lack of an MSHR",
+                  "accesses");
+    r.add_counter(name("evictions"), counters_.evictions, "valid lines replaced", "lines");
+    r.add_ratio(name("hit_rate"), name("hits"), name("reads"), "hits / reads");
+}
+
+ICacheBanks::ICacheBanks(const ICacheConfig& config, uint32_t num_threads)
+    : threads_per_icache_(config.threads_per_icache),
+      banks_per_icache_(config.banks),
+      banks_(size_t{(num_threads + config.threads_per_icache - 1) / config.threads_per_icache} *
+             config.banks) {}
+
+bool ICacheBanks::fetch(uint64_t now, uint32_t tp, uint32_t pc) {
+    const uint32_t icache = tp / threads_per_icache_;
+    Bank& bank = banks_[size_t{icache} * banks_per_icache_ + (pc / 4) % banks_per_icache_];
+    if (bank.cycle == now && bank.pc != pc) {
+        ++counters_.conflicts;
+        return false;
+    }
+    bank = {now, pc};
+    ++counters_.fetches;
+    return true;
+}
+
+void ICacheBanks::register_stats(stats::Registry& r, std::string_view prefix) const {
+    r.add_counter(fmt::format("{}/fetches", prefix), counters_.fetches, "instructions fetched");
+    r.add_counter(fmt::format("{}/conflicts", prefix), counters_.conflicts,
+                  "fetches refused by an I-cache bank conflict (one cycle lost each)");
+}
+
+}  // namespace tpsim::timing

@@ -1,0 +1,124 @@
+// A banked, set-associative (true LRU), non-blocking data cache with MSHRs that merge misses
+// to the same line, used for the per-TM L1 and the per-group L2.
+//
+// Policy (docs/hardware-model.md): reads allocate; stores are write-around (as in TRaX): a store
+// is forwarded to the next level, never allocates, and leaves a present line valid; stores need
+// no reply. Each bank accepts one access per cycle; bank = line number % banks. Fills do not
+// occupy a bank. Data values are never stored: the functional core owns them.
+#pragma once
+#include "stats/registry.hpp"
+#include "timing/config.hpp"
+#include "timing/memory.hpp"
+
+#include <cstdint>
+#include <deque>
+#include <string_view>
+#include <vector>
+
+namespace tpsim::timing {
+
+enum class CacheOutcome : uint8_t {
+    Hit,           ///< reply queued for now + hit_latency
+    Miss,          ///< a line request went to the next level
+    MergedMiss,    ///< joined an outstanding miss to the same line
+    WriteForward,  ///< store accepted and forwarded (write-around)
+    BankConflict,  ///< bank already used this cycle: nothing happened, retry next cycle
+    MshrFull,      ///< no MSHR free: nothing happened, retry later
+};
+
+inline bool accepted(CacheOutcome o) {
+    return o != CacheOutcome::BankConflict && o != CacheOutcome::MshrFull;
+}
+
+class Cache {
+public:
+    struct Counters {
+        uint64_t reads = 0;           ///< accepted loads (= hits + misses + merged_misses)
+        uint64_t writes = 0;          ///< accepted stores
+        uint64_t hits = 0;
+        uint64_t misses = 0;          ///< loads that sent a line request to the next level
+        uint64_t merged_misses = 0;   ///< loads that joined an outstanding miss
+        uint64_t bank_conflicts = 0;  ///< refused accesses (bank busy this cycle)
+        uint64_t mshr_full = 0;       ///< refused loads (no MSHR free)
+        uint64_t evictions = 0;       ///< valid lines replaced by fills
+    };
+
+    explicit Cache(const CacheConfig& config);
+
+    /// Presents one access in cycle `now`; calls must come in non-decreasing `now`.
+    CacheOutcome access(uint64_t now, const MemRequest& request);
+    /// The line holding `line_addr` arrives from the next level in cycle `now`: it is
+    /// installed (evicting the LRU way) and every merged waiter gets a reply at now + hit_latency.
+    void fill(uint64_t now, uint32_t line_addr);
+    /// Pops the oldest reply whose data is ready by `now`.
+    bool pop_reply(uint64_t now, MemReply& reply);
+
+    /// Requests for the next level in the order they were made; the owner drains it.
+    std::deque<OutboundRequest>& outbound() { return outbound_; }
+    bool contains(uint32_t addr) const;
+    uint32_t line_of(uint32_t addr) const { return addr & ~(config_.line_bytes - 1); }
+    uint32_t bank_of(uint32_t addr) const { return (addr / config_.line_bytes) % config_.banks; }
+    uint32_t outstanding_misses() const;
+
+    const Counters& counters() const { return counters_; }
+    const CacheConfig& config() const { return config_; }
+    void register_stats(stats::Registry& registry, std::string_view prefix) const;
+
+private:
+    struct Way {
+        uint32_t line = 0;
+        bool valid = false;
+        uint64_t last_use = 0;  // LRU stamp from use_clock_; deterministic, never host time
+    };
+    struct Mshr {
+        uint32_t line = 0;
+        bool busy = false;
+        std::vector<MemRequest> waiters;
+    };
+
+    Way* find(uint32_t line);
+    const Way* find(uint32_t line) const;
+    uint32_t set_of(uint32_t line) const { return (line / config_.line_bytes) % num_sets_; }
+
+    CacheConfig config_;
+    uint32_t num_sets_;
+    std::vector<Way> ways_;               // num_sets_ x ways
+    std::vector<Mshr> mshrs_;
+    std::vector<uint64_t> bank_used_at_;  // last cycle each bank accepted an access
+    uint64_t use_clock_ = 0;
+    std::deque<MemReply> replies_;        // non-decreasing `ready`
+    std::deque<OutboundRequest> outbound_;
+    Counters counters_;
+};
+
+/// Instruction fetch banks: TRaX's I-cache never misses, so only bank conflicts are modelled.
+/// Threads sharing one I-cache fetch from banks interleaved by instruction word; each bank
+/// serves one address per cycle, and threads fetching the same address share it (broadcast).
+class ICacheBanks {
+public:
+    struct Counters {
+        uint64_t fetches = 0;    ///< granted fetches
+        uint64_t conflicts = 0;  ///< refused fetches (bank busy with another address)
+    };
+
+    ICacheBanks(const ICacheConfig& config, uint32_t num_threads);
+
+    /// Thread `tp` fetches `pc` in cycle `now`; false = conflict, try again next cycle.
+    /// Within a cycle, earlier callers win: the caller decides the (rotating) order.
+    bool fetch(uint64_t now, uint32_t tp, uint32_t pc);
+
+    const Counters& counters() const { return counters_; }
+    void register_stats(stats::Registry& registry, std::string_view prefix) const;
+
+private:
+    struct Bank {
+        uint64_t cycle = UINT64_MAX;  // cycle of the current reservation
+        uint32_t pc = 0;
+    };
+    uint32_t threads_per_icache_;
+    uint32_t banks_per_icache_;
+    std::vector<Bank> banks_;  // all I-caches of the TM, banks_per_icache_ each
+    Counters counters_;
+};
+
+}  // namespace tpsim::timing

@@ -1,0 +1,136 @@
+#include "timing/cache.hpp"
+
+#include <catch2/catch.hpp>
+
+using namespace tpsim::timing;
+
+namespace {
+
+// 8 sets x 2 ways x 64 B, 2 banks, 3-cycle hits, 2 MSHRs.
+const CacheConfig kSmall{1024, 2, 64, 2, 3, 2};
+constexpr uint32_t kSetStride = 8 * 64;  // addresses this far apart share a set
+
+MemRequest load(uint32_t addr, uint32_t tag = 0) { return {addr, 0, tag, false}; }
+MemRequest store(uint32_t addr) { return {addr, 0, 0, true}; }
+
+// Fake next level: answers every outbound read `latency` cycles after it becomes visible.
+void serve_next_level(Cache& cache, uint32_t latency) {
+    while (!cache.outbound().empty()) {
+        const OutboundRequest out = cache.outbound().front();
+        cache.outbound().pop_front();
+        if (!out.request.write) cache.fill(out.cycle + latency, out.request.addr);
+    }
+}
+
+uint64_t reply_cycle(Cache& cache, uint64_t from) {
+    MemReply reply;
+    for (uint64_t t = from; t < from + 1000; ++t)
+        if (cache.pop_reply(t, reply)) return t;
+    return 0;
+}
+
+}  // namespace
+
+TEST_CASE("a cache returns a hit after the configured latency", "[cache]") {
+    Cache cache(kSmall);
+    cache.fill(0, 0x100);
+    REQUIRE(cache.access(10, load(0x104, 7)) == CacheOutcome::Hit);
+    MemReply reply;
+    CHECK_FALSE(cache.pop_reply(12, reply));
+    REQUIRE(cache.pop_reply(13, reply));
+    CHECK(reply.ready == 13);
+    CHECK(reply.request.tag == 7);
+    CHECK(cache.counters().hits == 1);
+}
+
+TEST_CASE("a miss goes to the next level and returns after its latency plus two lookups",
+          "[cache]") {
+    Cache cache(kSmall);
+    REQUIRE(cache.access(0, load(0x1234)) == CacheOutcome::Miss);
+    REQUIRE(cache.outbound().size() == 1);
+    CHECK(cache.outbound().front().cycle == 3);          // after the tag lookup
+    CHECK(cache.outbound().front().request.addr == 0x1200);  // whole line
+    serve_next_level(cache, 20);
+    CHECK(reply_cycle(cache, 0) == 3 + 20 + 3);  // lookup, next level, fill-to-use
+    CHECK(cache.contains(0x1200));
+    CHECK(cache.counters().misses == 1);
+}
+
+TEST_CASE("MSHRs merge misses to one line and limit distinct outstanding lines", "[cache]") {
+    Cache cache(kSmall);
+    CHECK(cache.access(0, load(0x000, 1)) == CacheOutcome::Miss);
+    CHECK(cache.access(1, load(0x008, 2)) == CacheOutcome::MergedMiss);
+    CHECK(cache.access(2, load(0x040, 3)) == CacheOutcome::Miss);  // second MSHR
+    CHECK(cache.access(3, load(0x080, 4)) == CacheOutcome::MshrFull);
+    CHECK(cache.access(4, load(0x030, 5)) == CacheOutcome::MergedMiss);  // merging needs none
+    CHECK(cache.outbound().size() == 2);
+    CHECK(cache.outstanding_misses() == 2);
+    cache.fill(50, 0x000);
+    MemReply reply;
+    int woken = 0;
+    while (cache.pop_reply(53, reply)) {
+        ++woken;
+        CHECK(reply.ready == 53);
+    }
+    CHECK(woken == 3);  // tags 1, 2 and 5
+    CHECK(cache.access(54, load(0x080)) == CacheOutcome::Miss);  // MSHR freed
+    const auto& c = cache.counters();
+    CHECK(c.misses == 3);
+    CHECK(c.merged_misses == 2);
+    CHECK(c.mshr_full == 1);
+    CHECK(c.reads == c.hits + c.misses + c.merged_misses);
+}
+
+TEST_CASE("one access per bank per cycle; conflicts are counted and change nothing", "[cache]") {
+    Cache cache(kSmall);
+    cache.fill(0, 0x000);  // bank 0
+    cache.fill(0, 0x040);  // bank 1
+    CHECK(cache.bank_of(0x000) != cache.bank_of(0x040));
+    CHECK(cache.access(5, load(0x000)) == CacheOutcome::Hit);
+    CHECK(cache.access(5, load(0x080)) == CacheOutcome::BankConflict);  // bank 0 again
+    CHECK(cache.access(5, load(0x040)) == CacheOutcome::Hit);           // bank 1 is free
+    CHECK(cache.access(6, load(0x080)) == CacheOutcome::Miss);          // next cycle
+    CHECK(cache.counters().bank_conflicts == 1);
+    CHECK(cache.counters().reads == 3);
+}
+
+TEST_CASE("LRU evicts the least recently used way", "[cache]") {
+    Cache cache(kSmall);
+    const uint32_t a = 0, b = kSetStride, c = 2 * kSetStride;
+    cache.fill(0, a);
+    cache.fill(1, b);
+    CHECK(cache.access(2, load(a)) == CacheOutcome::Hit);  // a is now most recent
+    cache.fill(3, c);
+    CHECK(cache.contains(a));
+    CHECK_FALSE(cache.contains(b));
+    CHECK(cache.contains(c));
+    CHECK(cache.counters().evictions == 1);
+}
+
+TEST_CASE("stores are write-around: forwarded, never allocated, no reply", "[cache]") {
+    Cache cache(kSmall);
+    CHECK(cache.access(0, store(0x200)) == CacheOutcome::WriteForward);
+    CHECK_FALSE(cache.contains(0x200));
+    REQUIRE(cache.outbound().size() == 1);
+    CHECK(cache.outbound().front().request.write);
+    CHECK(cache.outbound().front().request.addr == 0x200);
+    cache.fill(1, 0x300);
+    CHECK(cache.access(2, store(0x300)) == CacheOutcome::WriteForward);
+    CHECK(cache.contains(0x300));
+    MemReply reply;
+    CHECK_FALSE(cache.pop_reply(100, reply));
+    CHECK(cache.counters().writes == 2);
+}
+
+TEST_CASE("I-cache banks: one address per bank per cycle, shared addresses broadcast",
+          "[icache]") {
+    ICacheBanks icache(ICacheConfig{16, 4}, 32);
+    CHECK(icache.fetch(0, 0, 0x1000));
+    CHECK(icache.fetch(0, 1, 0x1000));        // same address: broadcast
+    CHECK_FALSE(icache.fetch(0, 2, 0x1010));  // same bank (word 4 % 4), other address
+    CHECK(icache.fetch(0, 3, 0x1004));        // other bank
+    CHECK(icache.fetch(0, 16, 0x1010));       // thread 16 uses the second I-cache
+    CHECK(icache.fetch(1, 2, 0x1010));        // next cycle
+    CHECK(icache.counters().conflicts == 1);
+    CHECK(icache.counters().fetches == 5);
+}
