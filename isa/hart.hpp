@@ -38,5 +38,12 @@ inline void trap(Hart& h, uint32_t cause, uint32_t tval) {
 //                                                              // custom); false = not mine
 //   void env.ecall(Hart& h);  void env.ebreak(Hart& h);        // pc still at the instruction
 //   void env.illegal(Hart& h, const Decoded& d);               // pc still at the instruction
+//
+// ecall, ebreak and illegal instructions (including unknown CSRs, writes to read-only CSRs and
+// FP instructions whose dynamic rounding mode frm is 5..7) do not complete: execute() calls the
+// hook and returns without touching pc or instret, so the environment decides what follows
+// (halt the thread, emulate and advance pc itself, or call trap()). Every other instruction
+// completes: pc advances (or jumps) and instret is incremented. A load or store that throws
+// leaves the hart exactly as before the instruction.
 
 }  // namespace tpsim::isa

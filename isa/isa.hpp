@@ -1,6 +1,7 @@
 // The tpsim instruction set: RV32I + M + F + Zicsr + the small tpsim custom extension.
 // Every instruction is defined once, in instructions.def; everything here is derived from it.
 #pragma once
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -54,8 +55,25 @@ struct Decoded {
     uint8_t rs2 = kNoReg;
     uint8_t rs3 = kNoReg;
     uint8_t rm = 0;        ///< FP rounding-mode field (7 = dynamic)
-    int32_t imm = 0;       ///< sign-extended immediate; CSR number for Zicsr
+    uint8_t zimm = 0;      ///< 5-bit unsigned immediate of csrrwi/csrrsi/csrrci
+    int32_t imm = 0;       ///< sign-extended immediate; CSR number for Zicsr; shamt for shifts;
+                           ///< fm|pred|succ for fence
 };
+
+/// Which register file an operand field names.
+enum class RegKind : uint8_t { None, Int, Fp };
+
+/// The operand fields an instruction uses (rs3 is used, as Fp, by Format::R4 only).
+struct OperandInfo {
+    RegKind rd = RegKind::None, rs1 = RegKind::None, rs2 = RegKind::None;
+    bool rounding_mode = false;  ///< funct3 is a rounding mode
+};
+
+/// Parses the table's 4-character operand spec ("fffr", "xf--", ...; see instructions.def).
+constexpr OperandInfo operand_info(std::string_view spec) {
+    auto kind = [](char c) { return c == 'x' ? RegKind::Int : c == 'f' ? RegKind::Fp : RegKind::None; };
+    return {kind(spec[0]), kind(spec[1]), kind(spec[2]), spec[3] == 'r'};
+}
 
 /// Static facts about one instruction, straight from the table.
 struct InsnInfo {
@@ -64,7 +82,10 @@ struct InsnInfo {
     uint32_t mask;
     Format format;
     FuClass fu;
+    OperandInfo operands;
 };
+
+constexpr size_t kNumInsns = size_t(Op::Illegal);  ///< table entries (Op::Illegal excluded)
 
 const InsnInfo& info(Op op);
 
