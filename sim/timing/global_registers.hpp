@@ -1,0 +1,66 @@
+// The chip-wide global-register unit that serves atomic increments (how kernels hand out
+// work). TMs send requests stamped with their send cycle and a per-TM sequence number; the unit
+// serves them in (arrival cycle, TM, sequence) order, never in host call order, so the result
+// does not depend on which TM the host simulated first. Only timing lives here: the value each
+// thread receives is computed by the functional core.
+#pragma once
+#include "stats/registry.hpp"
+#include "timing/config.hpp"
+
+#include <cstdint>
+#include <functional>
+#include <queue>
+#include <string_view>
+#include <vector>
+
+namespace tpsim::timing {
+
+struct AtomicRequest {
+    uint64_t sent = 0;      ///< cycle the TM sent it
+    uint32_t tm = 0;
+    uint32_t sequence = 0;  ///< per-TM counter, breaks ties within a cycle
+    uint32_t tp = 0;        ///< returned in the reply
+    uint32_t tag = 0;       ///< returned in the reply (e.g. destination register)
+};
+
+struct AtomicReply {
+    uint64_t ready = 0;  ///< cycle the result is usable back at the TP
+    AtomicRequest request;
+};
+
+class GlobalRegisterUnit {
+public:
+    struct Counters {
+        uint64_t requests = 0;      ///< atomic increments served
+        uint64_t queued_cycles = 0; ///< total cycles requests waited for a service slot
+    };
+
+    explicit GlobalRegisterUnit(const GlobalRegisterConfig& config) : config_(config) {}
+
+    void submit(const AtomicRequest& request);
+    /// Serves up to per_cycle requests that have arrived by `now`. Call once per cycle, in order.
+    void tick(uint64_t now);
+    /// Pops the next reply ready by `now`, in service order.
+    bool pop_reply(uint64_t now, AtomicReply& reply);
+    bool idle() const { return waiting_.empty() && replies_.empty(); }
+
+    const Counters& counters() const { return counters_; }
+    void register_stats(stats::Registry& registry, std::string_view prefix) const;
+
+private:
+    struct Arrival {
+        uint64_t cycle;
+        AtomicRequest request;
+        bool operator>(const Arrival& o) const {
+            if (cycle != o.cycle) return cycle > o.cycle;
+            if (request.tm != o.request.tm) return request.tm > o.request.tm;
+            return request.sequence > o.request.sequence;
+        }
+    };
+    GlobalRegisterConfig config_;
+    std::priority_queue<Arrival, std::vector<Arrival>, std::greater<>> waiting_;
+    std::queue<AtomicReply> replies_;  // non-decreasing ready: served in order, fixed latency
+    Counters counters_;
+};
+
+}  // namespace tpsim::timing
