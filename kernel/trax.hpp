@@ -20,9 +20,12 @@ extern "C" void trax_main();
 #define TRAX_INLINE inline __attribute__((always_inline))
 
 namespace trax::detail {
-/// Byte address of global word (addr + offset). The word grid starts at kGlobalBase.
-TRAX_INLINE uint32_t global_byte_address(int addr, int offset) {
-    return map::kGlobalBase + static_cast<uint32_t>(addr + offset) * 4u;
+/// Global word (addr + offset); the word grid starts at kGlobalBase. Pointer arithmetic rather
+/// than integer arithmetic: the compiler then folds constant offsets into the load's immediate
+/// and shares one base register between the fields of a record.
+template <class T>
+TRAX_INLINE T* global_word(int addr, int offset) {
+    return reinterpret_cast<T*>(map::kGlobalBase) + addr + offset;
 }
 }  // namespace trax::detail
 
@@ -31,25 +34,25 @@ TRAX_INLINE uint32_t global_byte_address(int addr, int offset) {
 // not volatile: re-reading the same word may be merged, as with any memory read.
 TRAX_INLINE float loadf(int addr, int offset = 0) {
     float value;
-    const float* p = reinterpret_cast<const float*>(trax::detail::global_byte_address(addr, offset));
+    const float* p = trax::detail::global_word<const float>(addr, offset);
     asm("flw %0, %1" : "=f"(value) : "m"(*p));
     return value;
 }
 
 TRAX_INLINE int loadi(int addr, int offset = 0) {
     int value;
-    const int* p = reinterpret_cast<const int*>(trax::detail::global_byte_address(addr, offset));
+    const int* p = trax::detail::global_word<const int>(addr, offset);
     asm("lw %0, %1" : "=r"(value) : "m"(*p));
     return value;
 }
 
 TRAX_INLINE void storef(float value, int addr, int offset = 0) {
-    float* p = reinterpret_cast<float*>(trax::detail::global_byte_address(addr, offset));
+    float* p = trax::detail::global_word<float>(addr, offset);
     asm volatile("fsw %1, %0" : "=m"(*p) : "f"(value));
 }
 
 TRAX_INLINE void storei(int value, int addr, int offset = 0) {
-    int* p = reinterpret_cast<int*>(trax::detail::global_byte_address(addr, offset));
+    int* p = trax::detail::global_word<int>(addr, offset);
     asm volatile("sw %1, %0" : "=m"(*p) : "r"(value));
 }
 

@@ -60,17 +60,21 @@ ShearedRay shear(Vec3 origin, Vec3 dir) {
 /// `tri` with t_min < t < t_max. Two-sided. The paper's double-precision fallback for edge
 /// coefficients that are exactly zero is left out (TRaX has no doubles): such rays count as
 /// hits, so a ray through a shared edge is never lost, at worst reported by both triangles.
-bool intersect(const ShearedRay& r, int tri, float t_min, float t_max, float& t) {
-    // Vertices relative to the origin, sheared and scaled.
-    const float a_z = loadf(tri, kTriangleV0 + r.kz) - r.oz;
-    const float b_z = loadf(tri, kTriangleV1 + r.kz) - r.oz;
-    const float c_z = loadf(tri, kTriangleV2 + r.kz) - r.oz;
-    const float a_x = loadf(tri, kTriangleV0 + r.kx) - r.ox - r.sx * a_z;
-    const float a_y = loadf(tri, kTriangleV0 + r.ky) - r.oy - r.sy * a_z;
-    const float b_x = loadf(tri, kTriangleV1 + r.kx) - r.ox - r.sx * b_z;
-    const float b_y = loadf(tri, kTriangleV1 + r.ky) - r.oy - r.sy * b_z;
-    const float c_x = loadf(tri, kTriangleV2 + r.kx) - r.ox - r.sx * c_z;
-    const float c_y = loadf(tri, kTriangleV2 + r.ky) - r.oy - r.sy * c_z;
+/// Always inlined into the two loops so the ray stays in registers across triangles.
+[[gnu::always_inline]] inline bool intersect(const ShearedRay& r, int tri, float t_min, float t_max,
+                                            float& t) {
+    // Vertices relative to the origin, sheared and scaled. One address per permuted axis, so
+    // the three vertices' coordinates on it are constant offsets from it (one flw each).
+    const int x = tri + r.kx, y = tri + r.ky, z = tri + r.kz;
+    const float a_z = loadf(z, kTriangleV0) - r.oz;
+    const float b_z = loadf(z, kTriangleV1) - r.oz;
+    const float c_z = loadf(z, kTriangleV2) - r.oz;
+    const float a_x = loadf(x, kTriangleV0) - r.ox - r.sx * a_z;
+    const float a_y = loadf(y, kTriangleV0) - r.oy - r.sy * a_z;
+    const float b_x = loadf(x, kTriangleV1) - r.ox - r.sx * b_z;
+    const float b_y = loadf(y, kTriangleV1) - r.oy - r.sy * b_z;
+    const float c_x = loadf(x, kTriangleV2) - r.ox - r.sx * c_z;
+    const float c_y = loadf(y, kTriangleV2) - r.oy - r.sy * c_z;
 
     // Scaled barycentrics: edge functions in the sheared 2D space.
     const float u = c_x * b_y - c_y * b_x;
