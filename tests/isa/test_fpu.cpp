@@ -2,6 +2,10 @@
 // RISC-V unprivileged spec (ch. 11) and IEEE 754-2008; the derivation is in the comment.
 #include <catch2/catch.hpp>
 
+#include <cmath>
+#include <limits>
+#include <random>
+
 #include "test_support.hpp"
 
 using namespace tpsim::isa;
@@ -244,4 +248,43 @@ TEST_CASE("integer instructions do not touch fflags", "[isa][fpu]") {
     h.reg[1] = 1;
     run(h, env, encode(Op::div, x(3), x(1), x(0)));  // divide by zero: no FP flag
     CHECK(h.fflags == NX);
+}
+
+namespace {
+
+/// The float after `value` toward +inf (finite, non-NaN input).
+double next_up(float value) { return std::nextafter(value, std::numeric_limits<float>::infinity()); }
+double next_down(float value) { return std::nextafter(value, -std::numeric_limits<float>::infinity()); }
+
+}  // namespace
+
+TEST_CASE("fmul.s rounds correctly in every mode on random operands", "[isa][fpu][rounding]") {
+    // A float product is exact in double (48 significant bits), so each mode's defining property
+    // can be checked directly against the exact value: RDN gives the largest float <= exact, RUP
+    // the smallest >= exact, RTZ the one of those nearer zero, RNE/RMM the nearest (ties: even
+    // significand / larger magnitude). Exponents span normal and subnormal results.
+    std::mt19937 rng(2024);
+    std::uniform_int_distribution<uint32_t> significand(0, 0x7f'ffff), exponent(40, 170), sign(0, 1);
+    auto random_float = [&] { return sign(rng) << 31 | exponent(rng) << 23 | significand(rng); };
+    for (int trial = 0; trial < 20'000; ++trial) {
+        const uint32_t a = random_float(), b = random_float();
+        const double exact = double(std::bit_cast<float>(a)) * double(std::bit_cast<float>(b));
+        const float down = std::bit_cast<float>(fp(Op::fmul_s, a, b, RDN).value);
+        const float up = std::bit_cast<float>(fp(Op::fmul_s, a, b, RUP).value);
+        INFO(std::hex << a << " * " << b);
+        REQUIRE(double(down) <= exact);
+        REQUIRE(next_up(down) > exact);
+        REQUIRE(double(up) >= exact);
+        REQUIRE(next_down(up) < exact);
+        const float toward_zero = std::bit_cast<float>(fp(Op::fmul_s, a, b, RTZ).value);
+        REQUIRE(toward_zero == (exact < 0 ? up : down));
+        const bool tie = exact - double(down) == double(up) - exact;
+        const float nearer = exact - double(down) < double(up) - exact ? down : up;
+        const float even = (std::bit_cast<uint32_t>(down) & 1) ? up : down;
+        const float away = exact < 0 ? down : up;
+        CHECK(std::bit_cast<float>(fp(Op::fmul_s, a, b, RNE).value) == (tie ? even : nearer));
+        CHECK(std::bit_cast<float>(fp(Op::fmul_s, a, b, RMM).value) == (tie ? away : nearer));
+        // Inexact exactly when the two directed results differ.
+        CHECK(bool(fp(Op::fmul_s, a, b, RMM).flags & NX) == (down != up));
+    }
 }
