@@ -45,14 +45,24 @@ uint64_t subtree_capacity(uint32_t max_leaf_size, uint32_t levels) {
     return levels >= 40 ? std::numeric_limits<uint64_t>::max() / 2 : uint64_t{max_leaf_size} << levels;
 }
 
-/// A candidate object split: the first `left_count` triangles of the node's order go left.
-/// cost = A(left) * n_left + A(right) * n_right, i.e. the SAH without the node's own term.
+/// A candidate object split. cost = A(left) * n_left + A(right) * n_right, i.e. the SAH without
+/// the node's own term. `position` is where it cuts: the sweep builder's count of triangles that
+/// go left, the binned builder's count of bins that go left.
 struct Split {
     int axis = -1;
+    uint32_t position = 0;
     uint32_t left_count = 0;
     double cost = std::numeric_limits<double>::infinity();
     bool valid() const { return axis >= 0; }
 };
+
+/// Lower cost wins; on a tie (e.g. many identical boxes) the more balanced split, which keeps
+/// such trees shallow; then the earlier candidate, so the result never depends on anything else.
+bool better(const Split& candidate, const Split& incumbent, uint32_t count) {
+    if (candidate.cost != incumbent.cost) return candidate.cost < incumbent.cost;
+    const auto imbalance = [&](const Split& s) { return std::abs(2 * int64_t(s.left_count) - int64_t(count)); };
+    return imbalance(candidate) < imbalance(incumbent);
+}
 
 /// Shared by both builders: per-triangle boxes and centroids, node emission and the
 /// leaf-or-split decision, which is where the SAH and the depth limit meet.
@@ -173,11 +183,11 @@ private:
             for (uint32_t i = begin; i + 1 < end; ++i) {
                 left.grow(boxes_[order[i]]);
                 const uint32_t left_count = i + 1 - begin, right_count = count - left_count;
-                const double cost = double(left.area()) * left_count + double(right_area_[i + 1]) * right_count;
-                // Strict '<' keeps the first axis and leftmost position on ties: deterministic.
-                if (cost < best.cost) best = {axis, left_count, cost};
-                if (cost < feasible.cost && left_count <= child_cap && right_count <= child_cap)
-                    feasible = {axis, left_count, cost};
+                const Split candidate{axis, left_count, left_count,
+                                      double(left.area()) * left_count + double(right_area_[i + 1]) * right_count};
+                if (better(candidate, best, count)) best = candidate;
+                if (left_count <= child_cap && right_count <= child_cap && better(candidate, feasible, count))
+                    feasible = candidate;
             }
         }
     }
@@ -185,7 +195,7 @@ private:
     /// Splits the range on the chosen axis and carries the split over to the other two sorted
     /// lists with a stable partition, so they stay sorted.
     void partition(uint32_t begin, uint32_t end, const Split& split) {
-        const uint32_t middle = begin + split.left_count;
+        const uint32_t middle = begin + split.position;
         const auto& chosen = order_[split.axis];
         for (uint32_t i = begin; i < end; ++i) goes_right_[chosen[i]] = i >= middle;
         for (int axis = 0; axis < 3; ++axis) {
@@ -273,9 +283,9 @@ private:
         return uint32_t(std::clamp(slot, 0.f, float(bins_ - 1)));
     }
 
-    /// Split.left_count holds the number of bins that go left (the split is after that bin).
     void find_splits(uint32_t begin, uint32_t end, const Box& centroid_bounds, uint64_t child_cap, Split& best,
                      Split& feasible) {
+        const uint32_t count = end - begin;
         auto& [bins, right_area, right_count] = sweep_;
         for (int axis = 0; axis < 3; ++axis) {
             const float scale = bin_scale(axis, centroid_bounds);
@@ -301,10 +311,11 @@ private:
                 left_n += bins[b].count;
                 const uint32_t right_n_here = right_count[b + 1];
                 if (left_n == 0 || right_n_here == 0) continue;
-                const double cost = double(left.area()) * left_n + double(right_area[b + 1]) * right_n_here;
-                if (cost < best.cost) best = {axis, b + 1, cost};
-                if (cost < feasible.cost && left_n <= child_cap && right_n_here <= child_cap)
-                    feasible = {axis, b + 1, cost};
+                const Split candidate{axis, b + 1, left_n,
+                                      double(left.area()) * left_n + double(right_area[b + 1]) * right_n_here};
+                if (better(candidate, best, count)) best = candidate;
+                if (left_n <= child_cap && right_n_here <= child_cap && better(candidate, feasible, count))
+                    feasible = candidate;
             }
         }
     }
@@ -313,7 +324,7 @@ private:
         const float scale = bin_scale(split.axis, centroid_bounds);
         // std::partition is not stable but is a pure function of its input: still deterministic.
         const auto middle = std::partition(order_.begin() + begin, order_.begin() + end, [&](uint32_t t) {
-            return bin_of(t, split.axis, centroid_bounds, scale) < split.left_count;
+            return bin_of(t, split.axis, centroid_bounds, scale) < split.position;
         });
         return uint32_t(middle - order_.begin());
     }
@@ -337,6 +348,9 @@ private:
     BinSweep sweep_;  // reused by every node
 };
 
+/// Beyond this, box surface areas overflow float and the SAH becomes inf/inf.
+constexpr float kMaxCoordinate = 1e18f;
+
 void validate(std::span<const Triangle> triangles, const BvhConfig& config) {
     if (config.max_leaf_size < 1 || config.max_leaf_size > 8)
         throw std::invalid_argument(fmt::format("BVH: max_leaf_size must be in 1..8, got {}", config.max_leaf_size));
@@ -353,9 +367,10 @@ void validate(std::span<const Triangle> triangles, const BvhConfig& config) {
     for (size_t i = 0; i < triangles.size(); ++i) {
         const Triangle& t = triangles[i];
         for (const glm::vec3& v : {t.v0, t.v1, t.v2})
-            if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
-                throw std::invalid_argument(
-                    fmt::format("BVH: triangle {} has a non-finite vertex ({}, {}, {})", i, v.x, v.y, v.z));
+            if (!glm::all(glm::lessThanEqual(glm::abs(v), glm::vec3(kMaxCoordinate))))
+                throw std::invalid_argument(fmt::format(
+                    "BVH: triangle {} has vertex ({}, {}, {}); coordinates must be finite and within +-{:g}", i, v.x,
+                    v.y, v.z, kMaxCoordinate));
     }
 }
 

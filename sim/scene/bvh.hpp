@@ -65,7 +65,7 @@ struct Bvh {
     BvhStats stats;
 };
 
-/// Builds the BVH. Throws std::invalid_argument on an empty soup, a non-finite vertex, an
+/// Builds the BVH. Throws std::invalid_argument on an empty soup, a vertex beyond +-1e18, an
 /// out-of-range config, or more triangles than max_leaf_size * 2^traversal_stack_entries.
 Bvh build_bvh(std::span<const Triangle> triangles, const BvhConfig& config = {});
 

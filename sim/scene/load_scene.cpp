@@ -130,6 +130,14 @@ public:
         return node ? vec3(*node, join(prefix, key), allowed) : fallback;
     }
 
+    bool boolean(const toml::table& t, std::string_view prefix, std::string_view key, bool fallback) const {
+        const toml::node* node = t.get(key);
+        if (node == nullptr) return fallback;
+        if (!node->is_boolean())
+            fail(node->source(), fmt::format("{} must be true or false, got a {}", join(prefix, key), type_name(*node)));
+        return *node->value<bool>();
+    }
+
     std::string text(const toml::node& node, const std::string& name) const {
         if (!node.is_string()) fail(node.source(), fmt::format("{} must be a string, got a {}", name, type_name(node)));
         return std::string(*node.value<std::string_view>());
@@ -211,6 +219,21 @@ Camera read_camera(const Reader& r, const toml::table& t) {
         glm::length(glm::cross(glm::normalize(view), glm::normalize(camera.up))) < 1e-6f)
         r.fail(t.source(), "camera.up must be non-zero and not parallel to look_at - eye");
     return camera;
+}
+
+std::vector<PointLight> read_lights(const Reader& r, const toml::node& node) {
+    std::vector<PointLight> lights;
+    const auto tables = r.tables(node, "lights");
+    for (size_t i = 0; i < tables.size(); ++i) {
+        const std::string prefix = fmt::format("lights[{}]", i);
+        const toml::table& t = *tables[i];
+        r.allow_keys(t, prefix, {"position", "color", "intensity"});
+        const glm::vec3 position = r.vec3(r.required(t, prefix, "position"), join(prefix, "position"));
+        const glm::vec3 color = r.vec3(t, prefix, "color", kNonNegative, glm::vec3(1.f));
+        const float intensity = float(r.number(t, prefix, "intensity", kNonNegative, 1.0));
+        lights.push_back({position, color * intensity});
+    }
+    return lights;
 }
 
 std::optional<uint32_t> read_material_ref(const Reader& r, const toml::table& t, const std::string& prefix,
@@ -348,12 +371,12 @@ Camera frame_bounds(const Aabb& bounds, float aspect) {
     return camera;
 }
 
-PointLight default_light(const Camera& camera, const Aabb& bounds) {
+PointLight default_light(const Camera& camera, const Aabb& bounds, bool light_falloff) {
     const glm::vec3 center = 0.5f * (bounds.lo + bounds.hi);
     const float distance = glm::length(camera.eye - center);
     const glm::vec3 position = camera.eye + glm::vec3(0.f, 0.5f * distance, 0.f) + 0.25f * (camera.eye - center);
     const glm::vec3 to_center = position - center;
-    return {position, glm::vec3(glm::dot(to_center, to_center))};
+    return {position, glm::vec3(light_falloff ? glm::dot(to_center, to_center) : 1.f)};
 }
 
 Scene scene_from_mesh(const std::filesystem::path& mesh_path) {
@@ -370,7 +393,7 @@ Scene scene_from_mesh(const std::filesystem::path& mesh_path) {
     keep_used_materials(scene, mesh.materials);
     const Aabb bounds = bounds_of(scene.triangles);
     scene.camera = frame_bounds(bounds, float(scene.width) / float(scene.height));
-    scene.lights.push_back(default_light(scene.camera, bounds));
+    scene.lights.push_back(default_light(scene.camera, bounds, scene.light_falloff));
     return scene;
 }
 
@@ -385,7 +408,7 @@ Scene load_scene_file(const std::filesystem::path& toml_path) {
     } catch (const toml::parse_error& e) {
         r.fail(e.source(), fmt::format("TOML syntax: {}", e.description()));
     }
-    r.allow_keys(root, "", {"name", "image", "camera", "ambient", "background", "lights", "materials", "meshes",
+    r.allow_keys(root, "", {"name", "image", "shading", "camera", "ambient", "background", "lights", "materials", "meshes",
                             "generators"});
     Scene scene;
     scene.name = root.get("name") ? r.text(*root.get("name"), "name") : toml_path.stem().string();
@@ -396,6 +419,12 @@ Scene load_scene_file(const std::filesystem::path& toml_path) {
         scene.height = r.integer(image, "image", "height", 1, 16384, scene.height);
         scene.samples_per_pixel = r.integer(image, "image", "samples_per_pixel", 1, 65536, scene.samples_per_pixel);
     }
+    if (const toml::node* node = root.get("shading")) {
+        const toml::table& shading = r.table(*node, "shading");
+        r.allow_keys(shading, "shading", {"shadows", "light_falloff"});
+        scene.shadows = r.boolean(shading, "shading", "shadows", scene.shadows);
+        scene.light_falloff = r.boolean(shading, "shading", "light_falloff", scene.light_falloff);
+    }
     scene.ambient = r.vec3(root, "", "ambient", kNonNegative, scene.ambient);
     scene.background = r.vec3(root, "", "background", kNonNegative, scene.background);
 
@@ -403,6 +432,13 @@ Scene load_scene_file(const std::filesystem::path& toml_path) {
     if (const toml::node* node = root.get("materials"))
         for (auto&& [name, value] : r.table(*node, "materials"))
             materials.define({std::string(name.str()), r.vec3(value, join("materials", name.str()), kUnit)});
+
+    // Camera and lights are read before the geometry so their mistakes are reported even when
+    // a mesh is missing too; their defaults need the geometry's bounds, so they come last.
+    std::optional<Camera> camera;
+    if (const toml::node* node = root.get("camera")) camera = read_camera(r, r.table(*node, "camera"));
+    std::optional<std::vector<PointLight>> lights;
+    if (const toml::node* node = root.get("lights")) lights = read_lights(r, *node);
 
     const std::filesystem::path base = toml_path.parent_path();
     if (const toml::node* node = root.get("meshes")) {
@@ -419,23 +455,8 @@ Scene load_scene_file(const std::filesystem::path& toml_path) {
     keep_used_materials(scene, materials.list());
 
     const Aabb bounds = bounds_of(scene.triangles);
-    if (const toml::node* node = root.get("camera")) scene.camera = read_camera(r, r.table(*node, "camera"));
-    else scene.camera = frame_bounds(bounds, float(scene.width) / float(scene.height));
-
-    if (const toml::node* node = root.get("lights")) {
-        const auto lights = r.tables(*node, "lights");
-        for (size_t i = 0; i < lights.size(); ++i) {
-            const std::string prefix = fmt::format("lights[{}]", i);
-            const toml::table& t = *lights[i];
-            r.allow_keys(t, prefix, {"position", "color", "intensity"});
-            const glm::vec3 position = r.vec3(r.required(t, prefix, "position"), join(prefix, "position"));
-            const glm::vec3 color = r.vec3(t, prefix, "color", kNonNegative, glm::vec3(1.f));
-            const float intensity = float(r.number(t, prefix, "intensity", kNonNegative, 1.0));
-            scene.lights.push_back({position, color * intensity});
-        }
-    } else {
-        scene.lights.push_back(default_light(scene.camera, bounds));
-    }
+    scene.camera = camera ? *camera : frame_bounds(bounds, float(scene.width) / float(scene.height));
+    scene.lights = lights ? *lights : std::vector{default_light(scene.camera, bounds, scene.light_falloff)};
     return scene;
 }
 

@@ -29,8 +29,8 @@ Aabb bounds_of(std::span<const Triangle> triangles);
 /// (width / height), looking from the front (+z), a little right and above, y up.
 Camera frame_bounds(const Aabb& bounds, float aspect);
 
-/// A light above and behind the camera, bright enough that the irradiance I/d^2 at the centre
-/// of `bounds` is 1.
-PointLight default_light(const Camera& camera, const Aabb& bounds);
+/// A light above and behind the camera, bright enough that the irradiance at the centre of
+/// `bounds` is 1 (with falloff, I / d^2; without, I).
+PointLight default_light(const Camera& camera, const Aabb& bounds, bool light_falloff);
 
 }  // namespace tpsim::scene

@@ -45,9 +45,12 @@ ImportedMesh import_mesh(const std::filesystem::path& path) {
                                              where, path.extension().string()));
 
     Assimp::Importer importer;
-    // PreTransformVertices bakes node transforms in; FindDegenerates is deliberately absent:
+    // ValidateDataStructure runs first so a malformed file is an error, not an ai_assert abort in
+    // a later step (Debian's assimp keeps its asserts; e.g. an OFF file with a missing face list).
+    // PreTransformVertices bakes node transforms in. FindDegenerates is deliberately absent:
     // degenerate triangles stay in as a robustness test for the kernels.
-    const aiScene* file = importer.ReadFile(where, aiProcess_Triangulate | aiProcess_PreTransformVertices);
+    const aiScene* file = importer.ReadFile(
+        where, aiProcess_ValidateDataStructure | aiProcess_Triangulate | aiProcess_PreTransformVertices);
     if (file == nullptr)
         throw std::runtime_error(fmt::format("{}: cannot read mesh: {}", where, importer.GetErrorString()));
 

@@ -50,6 +50,8 @@ struct Scene {
     glm::vec3 background{0.f};
     uint32_t width = 256, height = 256;
     uint32_t samples_per_pixel = 1;
+    bool shadows = true;        ///< cast a shadow ray to every light
+    bool light_falloff = true;  ///< light intensity falls off with the squared distance
     std::vector<SourceSummary> sources;  ///< in the order they were loaded
 };
 

@@ -1,0 +1,245 @@
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <random>
+
+#include <catch2/catch.hpp>
+
+#include "bvh.hpp"
+#include "load_scene.hpp"
+#include "procedural.hpp"
+
+using namespace tpsim::scene;
+
+namespace {
+
+/// Checks every structural promise build_bvh makes, independently of how it was built.
+void check_invariants(const Bvh& bvh, const std::vector<Triangle>& triangles, const BvhConfig& config) {
+    const uint32_t n = uint32_t(triangles.size());
+    REQUIRE(bvh.triangle_order.size() == n);
+    REQUIRE(!bvh.nodes.empty());
+    std::vector<int> seen(n, 0);
+    std::vector<int> covered(n, 0);  // positions of triangle_order covered by leaves
+    uint32_t leaves = 0, max_depth = 0;
+    std::vector<std::pair<uint32_t, uint32_t>> pending{{0, 0}};
+    size_t visited = 0;
+    while (!pending.empty()) {
+        const auto [index, depth] = pending.back();
+        pending.pop_back();
+        ++visited;
+        REQUIRE(index < bvh.nodes.size());
+        const BvhNode& node = bvh.nodes[index];
+        for (int k = 0; k < 3; ++k) {
+            REQUIRE(std::isfinite(node.bounds.lo[k]));
+            REQUIRE(std::isfinite(node.bounds.hi[k]));
+            REQUIRE(node.bounds.lo[k] <= node.bounds.hi[k]);
+        }
+        if (node.is_leaf()) {
+            ++leaves;
+            max_depth = std::max(max_depth, depth);
+            REQUIRE(node.triangle_count <= config.max_leaf_size);
+            REQUIRE(uint64_t(node.first_triangle) + node.triangle_count <= n);
+            for (uint32_t i = node.first_triangle; i < node.first_triangle + node.triangle_count; ++i) {
+                ++covered[i];
+                const uint32_t t = bvh.triangle_order[i];
+                REQUIRE(t < n);
+                ++seen[t];
+                for (const glm::vec3& v : {triangles[t].v0, triangles[t].v1, triangles[t].v2})
+                    REQUIRE(node.bounds.contains(Aabb{v, v}));
+            }
+        } else {
+            const uint32_t left = index + 1, right = node.right_child;
+            REQUIRE(right > left);
+            REQUIRE(right < bvh.nodes.size());
+            REQUIRE(node.bounds.contains(bvh.nodes[left].bounds));
+            REQUIRE(node.bounds.contains(bvh.nodes[right].bounds));
+            pending.push_back({right, depth + 1});
+            pending.push_back({left, depth + 1});
+        }
+    }
+    CHECK(visited == bvh.nodes.size());  // every node reachable exactly once
+    CHECK(std::count(seen.begin(), seen.end(), 1) == n);
+    CHECK(std::count(covered.begin(), covered.end(), 1) == n);
+    CHECK(max_depth <= config.traversal_stack_entries);
+    CHECK(bvh.stats.max_depth == max_depth);
+    CHECK(bvh.stats.leaves == leaves);
+    CHECK(bvh.stats.nodes == 2 * leaves - 1);  // a full binary tree
+    uint32_t histogram_leaves = 0;
+    for (uint32_t c : bvh.stats.leaf_size_histogram) histogram_leaves += c;
+    CHECK(histogram_leaves == leaves);
+    CHECK(std::isfinite(bvh.stats.sah_cost));
+}
+
+std::vector<Triangle> random_soup(uint32_t count, uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> position(-10.f, 10.f), offset(-0.5f, 0.5f);
+    std::vector<Triangle> triangles;
+    for (uint32_t i = 0; i < count; ++i) {
+        const glm::vec3 c(position(rng), position(rng), position(rng));
+        triangles.push_back({c + glm::vec3(offset(rng), offset(rng), offset(rng)),
+                             c + glm::vec3(offset(rng), offset(rng), offset(rng)),
+                             c + glm::vec3(offset(rng), offset(rng), offset(rng)), 0});
+    }
+    return triangles;
+}
+
+/// Triangle i spans [r^i, r^(i+1)] along x: each is a fixed fraction of everything to its
+/// right, so greedy SAH peels one triangle per level and wants a tree as deep as the input.
+std::vector<Triangle> geometric_strip(uint32_t count) {
+    std::vector<Triangle> triangles;
+    double x = 1.0;
+    const double ratio = 1.00002;
+    for (uint32_t i = 0; i < count; ++i) {
+        const double next = x * ratio;
+        triangles.push_back({{float(x), 0.f, 0.f}, {float(next), 0.f, 0.f}, {float(x), float(next - x), 0.f}, 0});
+        x = next;
+    }
+    return triangles;
+}
+
+const BvhBuilder kBuilders[] = {BvhBuilder::sweep, BvhBuilder::binned};
+
+}  // namespace
+
+TEST_CASE("A hand-computed two-triangle tree has the expected SAH cost", "[bvh]") {
+    // Each triangle's box is a unit cube (area 6); together they span [0,10]x[0,1]x[0,1] (area 42).
+    // Leaf: 2 * 42 = 84; split: 42 + 6 + 6 = 54 -> split, cost (42 + 6 + 6) / 42.
+    const std::vector<Triangle> triangles{{{0, 0, 0}, {1, 1, 0}, {1, 0, 1}, 0}, {{9, 0, 0}, {10, 1, 0}, {10, 0, 1}, 0}};
+    for (BvhBuilder builder : kBuilders) {
+        const Bvh bvh = build_bvh(triangles, {.builder = builder});
+        CHECK(bvh.stats.nodes == 3);
+        CHECK(bvh.stats.sah_cost == Approx(54.0 / 42.0));
+    }
+}
+
+TEST_CASE("Overlapping triangles stay in one leaf when splitting does not pay", "[bvh]") {
+    // Same box twice: leaf 2A against split A + A + A.
+    const Triangle t{{0, 0, 0}, {1, 1, 0}, {1, 0, 1}, 0};
+    for (BvhBuilder builder : kBuilders) {
+        const Bvh bvh = build_bvh(std::vector<Triangle>{t, t}, {.builder = builder});
+        CHECK(bvh.stats.nodes == 1);
+        CHECK(bvh.stats.sah_cost == Approx(2.0));
+    }
+}
+
+TEST_CASE("Random soups give valid trees for every builder and leaf size", "[bvh]") {
+    const auto triangles = random_soup(5000, 42);
+    for (BvhBuilder builder : kBuilders)
+        for (uint32_t leaf : {1u, 2u, 4u, 8u}) {
+            INFO(to_string(builder) << " leaf " << leaf);
+            const BvhConfig config{.builder = builder, .max_leaf_size = leaf};
+            const Bvh bvh = build_bvh(triangles, config);
+            check_invariants(bvh, triangles, config);
+            CHECK(bvh.stats.sah_cost == Approx(sah_cost(bvh)));
+            CHECK(bvh.stats.depth_limited_nodes == 0);
+        }
+}
+
+TEST_CASE("Builds are deterministic", "[bvh]") {
+    const auto triangles = random_soup(20000, 7);
+    for (BvhBuilder builder : kBuilders) {
+        const Bvh a = build_bvh(triangles, {.builder = builder});
+        const Bvh b = build_bvh(triangles, {.builder = builder});
+        REQUIRE(a.triangle_order == b.triangle_order);
+        REQUIRE(a.nodes.size() == b.nodes.size());
+        for (size_t i = 0; i < a.nodes.size(); ++i) {
+            REQUIRE(a.nodes[i].bounds.lo == b.nodes[i].bounds.lo);
+            REQUIRE(a.nodes[i].bounds.hi == b.nodes[i].bounds.hi);
+            REQUIRE(a.nodes[i].right_child == b.nodes[i].right_child);
+            REQUIRE(a.nodes[i].first_triangle == b.nodes[i].first_triangle);
+            REQUIRE(a.nodes[i].triangle_count == b.nodes[i].triangle_count);
+        }
+    }
+}
+
+TEST_CASE("The depth limit holds on a 2^20-triangle geometric strip", "[bvh][slow]") {
+    const auto triangles = geometric_strip(1u << 20);
+    for (BvhBuilder builder : kBuilders) {
+        INFO(to_string(builder));
+        const BvhConfig config{.builder = builder};
+        const Bvh bvh = build_bvh(triangles, config);
+        check_invariants(bvh, triangles, config);
+        CHECK(bvh.stats.max_depth <= 32);
+    }
+}
+
+TEST_CASE("A tiny stack forces a shallow tree and says so", "[bvh]") {
+    // 1000 triangles, leaves of 8 and depth <= 7: at most 8 * 2^7 = 1024 triangles fit, so
+    // the limit must shape the tree.
+    const auto triangles = geometric_strip(1000);
+    for (BvhBuilder builder : kBuilders) {
+        INFO(to_string(builder));
+        const BvhConfig config{.builder = builder, .traversal_stack_entries = 7};
+        const Bvh bvh = build_bvh(triangles, config);
+        check_invariants(bvh, triangles, config);
+        CHECK(bvh.stats.depth_limited_nodes > 0);
+    }
+    const BvhConfig too_small{.traversal_stack_entries = 6};
+    CHECK_THROWS_WITH(build_bvh(triangles, too_small), Catch::Contains("traversal_stack_entries"));
+}
+
+TEST_CASE("Identical and degenerate triangles build valid trees", "[bvh]") {
+    std::vector<Triangle> triangles(1000, Triangle{{1, 2, 3}, {4, 5, 6}, {7, 8, 10}, 0});
+    std::vector<Triangle> points(300, Triangle{{1, 1, 1}, {1, 1, 1}, {1, 1, 1}, 0});
+    std::vector<Triangle> lines;
+    for (int i = 0; i < 300; ++i) lines.push_back({{float(i), 0, 0}, {float(i + 1), 0, 0}, {float(i), 0, 0}, 0});
+    for (const auto* soup : {&triangles, &points, &lines})
+        for (BvhBuilder builder : kBuilders) {
+            const BvhConfig config{.builder = builder};
+            const Bvh bvh = build_bvh(*soup, config);
+            check_invariants(bvh, *soup, config);
+            CHECK(bvh.stats.max_depth <= 10);  // ties split in half: log2(1000 / 8) ~ 7
+        }
+}
+
+TEST_CASE("The SAH cost does not depend on scale or position", "[bvh]") {
+    std::vector<Triangle> sphere;
+    generate_sphere({{0, 0, 0}, 1.f, 48, 24}, 0, sphere);
+    const double reference = build_bvh(sphere).stats.sah_cost;
+    for (float scale : {1e-4f, 1e4f})
+        for (float shift : {0.f, 1e5f}) {
+            INFO("scale " << scale << " shift " << shift);
+            std::vector<Triangle> moved = sphere;
+            for (Triangle& t : moved)
+                for (glm::vec3* v : {&t.v0, &t.v1, &t.v2}) *v = *v * scale + glm::vec3(shift);
+            for (BvhBuilder builder : kBuilders) {
+                const BvhConfig config{.builder = builder};
+                const Bvh bvh = build_bvh(moved, config);
+                check_invariants(bvh, moved, config);
+                // At 1e-4 scale and 1e5 offset float spacing (~0.008) exceeds the sphere: it
+                // collapses to a point, so only the well-conditioned cases must match.
+                if (shift == 0.f || scale >= 1.f) CHECK(bvh.stats.sah_cost == Approx(reference).epsilon(0.05));
+            }
+        }
+}
+
+TEST_CASE("Bad input and bad configs are rejected with a clear message", "[bvh]") {
+    const std::vector<Triangle> one{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, 0}};
+    CHECK_THROWS_WITH(build_bvh(std::vector<Triangle>{}), Catch::Contains("no triangles"));
+    CHECK_THROWS_WITH(build_bvh(one, {.max_leaf_size = 0}), Catch::Contains("max_leaf_size must be in 1..8"));
+    CHECK_THROWS_WITH(build_bvh(one, {.max_leaf_size = 9}), Catch::Contains("max_leaf_size must be in 1..8"));
+    CHECK_THROWS_WITH(build_bvh(one, {.bins = 1}), Catch::Contains("bins"));
+    std::vector<Triangle> bad = one;
+    bad[0].v1.y = std::numeric_limits<float>::quiet_NaN();
+    CHECK_THROWS_WITH(build_bvh(bad), Catch::Contains("triangle 0"));
+    bad[0].v1.y = 1e30f;
+    CHECK_THROWS_WITH(build_bvh(bad), Catch::Contains("within"));
+}
+
+TEST_CASE("Bunny: sweep SAH cost <= 32.5", "[bvh][bunny]") {
+    const std::filesystem::path bunny = "/usr/share/glmark2/models/bunny.obj";
+    if (!std::filesystem::exists(bunny)) {
+        WARN("SKIPPED: " << bunny << " missing; install glmark2-data (scripts/setup does)");
+        return;
+    }
+    const Scene scene = load_scene(bunny);
+    REQUIRE(scene.triangles.size() == 69666);
+    for (BvhBuilder builder : kBuilders) {
+        const BvhConfig config{.builder = builder};
+        const Bvh bvh = build_bvh(scene.triangles, config);
+        check_invariants(bvh, scene.triangles, config);
+        // Best public binary builders reach 31.5-31.9 with this cost model; binned may trail.
+        CHECK(bvh.stats.sah_cost <= (builder == BvhBuilder::sweep ? 32.5 : 33.5));
+        CHECK(bvh.stats.sah_cost > 20.0);  // far below the state of the art would mean a wrong cost
+    }
+}
