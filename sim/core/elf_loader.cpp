@@ -1,0 +1,309 @@
+#include "elf_loader.hpp"
+
+#include <algorithm>
+#include <cstddef>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <memory>
+
+#include <elf.h>
+#include <elfutils/libdw.h>
+#include <fmt/format.h>
+#include <gelf.h>
+#include <libelf.h>
+
+#include "error.hpp"
+#include "kernel/memory_map.hpp"
+
+namespace tpsim::core {
+namespace {
+
+constexpr const char* kBuildHint =
+    "build it with clang --target=riscv32-unknown-elf -march=rv32imf -mabi=ilp32f";
+
+[[noreturn]] void reject(const std::string& name, const std::string& problem) {
+    throw Error(fmt::format("cannot load '{}': {}", name, problem));
+}
+
+struct ElfCloser {
+    void operator()(Elf* e) const { elf_end(e); }
+};
+using ElfHandle = std::unique_ptr<Elf, ElfCloser>;
+
+std::string machine_name(uint16_t machine) {
+    switch (machine) {
+        case EM_386: return "x86 (3)";
+        case EM_X86_64: return "x86-64 (62)";
+        case EM_ARM: return "ARM (40)";
+        case EM_AARCH64: return "AArch64 (183)";
+        case EM_MIPS: return "MIPS (8)";
+        default: return std::to_string(machine);
+    }
+}
+
+/// Header checks done on raw bytes first, so a hostile or truncated file never reaches libelf
+/// with offsets pointing outside the buffer. The machine is checked before the class: e_machine
+/// sits at the same offset in ELF32 and ELF64, and "x86-64, not RISC-V" is the better message.
+void check_identity(std::span<const uint8_t> image, const std::string& name) {
+    if (image.size() < SELFMAG || std::memcmp(image.data(), ELFMAG, SELFMAG) != 0)
+        reject(name, "not an ELF file (bad magic number); " + std::string(kBuildHint));
+    constexpr size_t kMachineEnd = offsetof(Elf32_Ehdr, e_machine) + 2;
+    if (image.size() < kMachineEnd)
+        reject(name, "truncated ELF identification; the file is damaged, rebuild it");
+    if (image[EI_DATA] != ELFDATA2LSB)
+        reject(name, "big-endian ELF, tpsim runs little-endian RISC-V; " + std::string(kBuildHint));
+    const uint16_t machine = uint16_t(image[kMachineEnd - 2] | image[kMachineEnd - 1] << 8);
+    if (machine != EM_RISCV)
+        reject(name, fmt::format("ELF machine {} is not RISC-V ({}); {}", machine_name(machine),
+                                 EM_RISCV, kBuildHint));
+    if (image[EI_CLASS] == ELFCLASS64)
+        reject(name, "64-bit (RV64) ELF, tpsim runs RV32 programs; " + std::string(kBuildHint));
+    if (image[EI_CLASS] != ELFCLASS32)
+        reject(name, fmt::format("unknown ELF class {}; the file is damaged, rebuild it",
+                                 image[EI_CLASS]));
+    if (image.size() < sizeof(Elf32_Ehdr))
+        reject(name, fmt::format("truncated ELF header ({} of {} bytes); rebuild the program",
+                                 image.size(), sizeof(Elf32_Ehdr)));
+}
+
+void check_header(const Elf32_Ehdr& eh, size_t file_size, const std::string& name) {
+    if (eh.e_type != ET_EXEC)
+        reject(name, fmt::format("ELF type {} is not an executable (ET_EXEC); link the object "
+                                 "files into a static executable with ld.lld",
+                                 eh.e_type));
+    if (eh.e_flags & EF_RISCV_RVC)
+        reject(name, "built with compressed instructions (C extension), which TRaX does not "
+                     "execute; use -march=rv32imf");
+    if (eh.e_phnum == 0) reject(name, "no program headers; link it as a static executable");
+    if (eh.e_phentsize != sizeof(Elf32_Phdr))
+        reject(name, fmt::format("program header size {} (expected {}); the file is damaged",
+                                 eh.e_phentsize, sizeof(Elf32_Phdr)));
+    const uint64_t ph_end = uint64_t(eh.e_phoff) + uint64_t(eh.e_phnum) * eh.e_phentsize;
+    if (ph_end > file_size)
+        reject(name, fmt::format("truncated: program headers end at byte {} but the file has {} "
+                                 "bytes; rebuild the program",
+                                 ph_end, file_size));
+    if (eh.e_shnum != 0) {
+        const uint64_t sh_end = uint64_t(eh.e_shoff) + uint64_t(eh.e_shnum) * eh.e_shentsize;
+        if (eh.e_shentsize != sizeof(Elf32_Shdr) || sh_end > file_size)
+            reject(name, fmt::format("truncated: section headers end at byte {} but the file "
+                                     "has {} bytes; rebuild the program",
+                                     sh_end, file_size));
+    }
+}
+
+std::string permissions(const Segment& s) {
+    return fmt::format("{}{}{}", s.readable ? 'r' : '-', s.writable ? 'w' : '-',
+                       s.executable ? 'x' : '-');
+}
+
+void check_segment_placement(const Segment& s, const std::string& name) {
+    using namespace trax::map;
+    const uint64_t end = uint64_t(s.vaddr) + s.memsz;
+    const std::string where = fmt::format("segment [{:#010x}, {:#010x}) ({})", s.vaddr, end,
+                                          permissions(s));
+    if (s.vaddr < kCodeBase)
+        reject(name, fmt::format("{} lies below the code base {:#010x} (the null guard); link "
+                                 "with the kernel linker script or -Ttext={:#x}",
+                                 where, kCodeBase, kCodeBase));
+    if (end > kGlobalBase)
+        reject(name, fmt::format("{} reaches into global memory at {:#010x}; the program must fit "
+                                 "in [{:#010x}, {:#010x}) — shrink static data",
+                                 where, kGlobalBase, kCodeBase, kGlobalBase));
+    if (s.executable && s.writable)
+        reject(name, fmt::format("{} is writable and executable; tpsim decodes code once, so "
+                                 "keep .text read-only (no self-modifying code)",
+                                 where));
+    if (s.executable && s.vaddr % 4 != 0)
+        reject(name, fmt::format("executable {} is not 4-byte aligned; align .text to 4", where));
+}
+
+std::vector<Segment> read_segments(Elf* elf, const Elf32_Ehdr& eh,
+                                   std::span<const uint8_t> image, const std::string& name) {
+    std::vector<Segment> segments;
+    for (size_t i = 0; i < eh.e_phnum; ++i) {
+        GElf_Phdr ph;
+        if (!gelf_getphdr(elf, int(i), &ph))
+            reject(name, fmt::format("program header {} unreadable: {}", i, elf_errmsg(-1)));
+        if (ph.p_type != PT_LOAD || ph.p_memsz == 0) continue;
+        if (ph.p_filesz > ph.p_memsz)
+            reject(name, fmt::format("program header {} has file size {} > memory size {}; the "
+                                     "file is damaged",
+                                     i, ph.p_filesz, ph.p_memsz));
+        if (ph.p_offset + ph.p_filesz > image.size())
+            reject(name, fmt::format("segment {} lies outside the file (bytes [{}, {}) of {}); the "
+                                     "file is truncated or damaged",
+                                     i, ph.p_offset, ph.p_offset + ph.p_filesz, image.size()));
+        Segment s;
+        s.vaddr = uint32_t(ph.p_vaddr);
+        s.memsz = uint32_t(ph.p_memsz);
+        s.readable = ph.p_flags & PF_R;
+        s.writable = ph.p_flags & PF_W;
+        s.executable = ph.p_flags & PF_X;
+        const auto* from = image.data() + ph.p_offset;
+        s.bytes.assign(from, from + ph.p_filesz);
+        check_segment_placement(s, name);
+        segments.push_back(std::move(s));
+    }
+    if (segments.empty()) reject(name, "no loadable segments; link it as a static executable");
+    std::sort(segments.begin(), segments.end(),
+              [](const Segment& a, const Segment& b) { return a.vaddr < b.vaddr; });
+    for (size_t i = 1; i < segments.size(); ++i)
+        if (segments[i].vaddr < segments[i - 1].end())
+            reject(name, fmt::format("segments [{:#010x}, {:#010x}) and [{:#010x}, {:#010x}) "
+                                     "overlap; fix the linker script",
+                                     segments[i - 1].vaddr, segments[i - 1].end(),
+                                     segments[i].vaddr, segments[i].end()));
+    return segments;
+}
+
+/// Function symbols and bare code labels that lie in executable segments.
+std::vector<Symbol> read_functions(Elf* elf, const std::vector<Segment>& segments) {
+    std::vector<Symbol> functions;
+    const auto in_code = [&](uint32_t a) {
+        return std::any_of(segments.begin(), segments.end(),
+                           [a](const Segment& s) { return s.executable && s.contains(a); });
+    };
+    for (Elf_Scn* scn = elf_nextscn(elf, nullptr); scn; scn = elf_nextscn(elf, scn)) {
+        GElf_Shdr sh;
+        if (!gelf_getshdr(scn, &sh) || sh.sh_type != SHT_SYMTAB || sh.sh_entsize == 0) continue;
+        Elf_Data* data = elf_getdata(scn, nullptr);
+        if (!data) continue;
+        const size_t count = data->d_size / sh.sh_entsize;
+        for (size_t i = 0; i < count; ++i) {
+            GElf_Sym sym;
+            if (!gelf_getsym(data, int(i), &sym)) continue;
+            const int type = GELF_ST_TYPE(sym.st_info);
+            if ((type != STT_FUNC && type != STT_NOTYPE) || sym.st_shndx == SHN_UNDEF) continue;
+            const char* n = elf_strptr(elf, sh.sh_link, sym.st_name);
+            // Skip unnamed symbols, local labels (.L*) and RISC-V mapping symbols ($x, $d).
+            if (!n || !*n || n[0] == '.' || n[0] == '$') continue;
+            if (!in_code(uint32_t(sym.st_value))) continue;
+            functions.push_back({n, uint32_t(sym.st_value), uint32_t(sym.st_size)});
+        }
+    }
+    // Sized (typed) symbols first at equal addresses, so lookups prefer them; then by name for
+    // a deterministic order.
+    std::sort(functions.begin(), functions.end(), [](const Symbol& a, const Symbol& b) {
+        if (a.address != b.address) return a.address < b.address;
+        if ((a.size != 0) != (b.size != 0)) return a.size != 0;
+        return a.name < b.name;
+    });
+    return functions;
+}
+
+/// Fills the line table from .debug_line when present; missing or unreadable DWARF just means
+/// messages carry no file:line.
+void read_lines(Elf* elf, Program& program) {
+    Dwarf* dwarf = dwarf_begin_elf(elf, DWARF_C_READ, nullptr);
+    if (!dwarf) return;
+    std::map<std::string, uint32_t> file_index;
+    Dwarf_Off offset = 0, next = 0;
+    size_t header_size = 0;
+    while (dwarf_nextcu(dwarf, offset, &next, &header_size, nullptr, nullptr, nullptr) == 0) {
+        Dwarf_Die cu;
+        Dwarf_Lines* lines = nullptr;
+        size_t count = 0;
+        if (dwarf_offdie(dwarf, offset + header_size, &cu) &&
+            dwarf_getsrclines(&cu, &lines, &count) == 0) {
+            for (size_t i = 0; i < count; ++i) {
+                Dwarf_Line* line = dwarf_onesrcline(lines, i);
+                Dwarf_Addr addr = 0;
+                int lineno = 0;
+                bool end = false;
+                if (!line || dwarf_lineaddr(line, &addr) != 0 || dwarf_lineno(line, &lineno) != 0 ||
+                    dwarf_lineendsequence(line, &end) != 0)
+                    continue;
+                const char* src = dwarf_linesrc(line, nullptr, nullptr);
+                std::string file = src ? src : "?";
+                if (auto slash = file.rfind('/'); slash != std::string::npos)
+                    file = file.substr(slash + 1);
+                auto [it, inserted] = file_index.try_emplace(file, program.line_files.size());
+                if (inserted) program.line_files.push_back(file);
+                program.line_rows.push_back({uint32_t(addr), uint32_t(lineno), it->second, end});
+            }
+        }
+        offset = next;
+    }
+    dwarf_end(dwarf);
+    // Stable: an end-of-sequence row and the next sequence's first row may share an address;
+    // keeping emission order lets the later (real) row win in source_at's upper_bound.
+    std::stable_sort(program.line_rows.begin(), program.line_rows.end(),
+                     [](const auto& a, const auto& b) { return a.address < b.address; });
+}
+
+}  // namespace
+
+const Symbol* Program::function_at(uint32_t pc) const {
+    auto it = std::upper_bound(functions.begin(), functions.end(), pc,
+                               [](uint32_t a, const Symbol& s) { return a < s.address; });
+    if (it == functions.begin()) return nullptr;
+    // Among symbols at the same address the sized one sorts first; walk back to it.
+    const uint32_t address = std::prev(it)->address;
+    while (it != functions.begin() && std::prev(it)->address == address) --it;
+    const Symbol& s = *it;
+    if (s.size != 0 && pc - s.address >= s.size) return nullptr;
+    return &s;
+}
+
+std::string Program::describe_pc(uint32_t pc) const {
+    const Symbol* s = function_at(pc);
+    if (!s) return "";
+    return pc == s->address ? s->name : fmt::format("{}+{:#x}", s->name, pc - s->address);
+}
+
+std::optional<SourceLocation> Program::source_at(uint32_t pc) const {
+    auto it = std::upper_bound(line_rows.begin(), line_rows.end(), pc,
+                               [](uint32_t a, const LineRow& r) { return a < r.address; });
+    if (it == line_rows.begin()) return std::nullopt;
+    const LineRow& row = *std::prev(it);
+    if (row.end_sequence || row.line == 0) return std::nullopt;
+    return SourceLocation{line_files[row.file], row.line};
+}
+
+const Segment* Program::segment_at(uint32_t addr) const {
+    for (const Segment& s : segments)
+        if (s.contains(addr)) return &s;
+    return nullptr;
+}
+
+Program load_elf(std::span<const uint8_t> image, const std::string& name) {
+    check_identity(image, name);
+    Elf32_Ehdr eh;
+    std::memcpy(&eh, image.data(), sizeof eh);
+    check_header(eh, image.size(), name);
+
+    if (elf_version(EV_CURRENT) == EV_NONE)
+        throw Error("libelf is out of date (elf_version failed); reinstall libelf");
+    // libelf wants a mutable buffer; it stays alive until the handle is closed.
+    std::vector<char> buffer(image.begin(), image.end());
+    ElfHandle elf(elf_memory(buffer.data(), buffer.size()));
+    if (!elf || elf_kind(elf.get()) != ELF_K_ELF)
+        reject(name, fmt::format("libelf cannot read it ({}); the file is damaged", elf_errmsg(-1)));
+
+    Program program;
+    program.name = name;
+    program.entry = eh.e_entry;
+    program.segments = read_segments(elf.get(), eh, image, name);
+    const Segment* entry_segment = program.segment_at(program.entry);
+    if (program.entry == 0 || !entry_segment || !entry_segment->executable)
+        reject(name, fmt::format("entry point {:#010x} is not in an executable segment; define "
+                                 "_start (or pass -e to the linker)",
+                                 program.entry));
+    program.functions = read_functions(elf.get(), program.segments);
+    read_lines(elf.get(), program);
+    return program;
+}
+
+Program load_elf(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw Error(fmt::format("cannot open '{}': no such file or not readable", path));
+    std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)),
+                               std::istreambuf_iterator<char>());
+    if (in.bad()) throw Error(fmt::format("cannot read '{}': I/O error", path));
+    return load_elf(bytes, path);
+}
+
+}  // namespace tpsim::core

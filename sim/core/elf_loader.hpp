@@ -1,0 +1,69 @@
+// Loads a kernel ELF (RV32, little-endian, statically linked) into a self-contained Program.
+#pragma once
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace tpsim::core {
+
+/// One PT_LOAD segment: `bytes` holds the file contents (p_filesz); the rest of memsz is zero.
+struct Segment {
+    uint32_t vaddr = 0;
+    uint32_t memsz = 0;
+    std::vector<uint8_t> bytes;
+    bool readable = false, writable = false, executable = false;
+
+    uint32_t end() const { return vaddr + memsz; }
+    bool contains(uint32_t addr) const { return addr - vaddr < memsz; }
+};
+
+/// A function (or code label) from the symbol table, for pc -> name lookups.
+struct Symbol {
+    std::string name;
+    uint32_t address = 0;
+    uint32_t size = 0;  ///< 0 when the symbol carries no size (plain assembly labels)
+};
+
+struct SourceLocation {
+    std::string file;  ///< file name as recorded by the compiler (no directory)
+    uint32_t line = 0;
+};
+
+/// Everything the simulator needs from the ELF; no libelf handles are kept.
+class Program {
+public:
+    std::string name;                ///< path or label, for messages
+    uint32_t entry = 0;
+    std::vector<Segment> segments;   ///< sorted by vaddr, non-overlapping
+    std::vector<Symbol> functions;   ///< sorted by address
+
+    /// The function containing pc, or the nearest preceding unsized label; nullptr if none.
+    const Symbol* function_at(uint32_t pc) const;
+    /// "name+0x40" or "" when pc lies in no known function.
+    std::string describe_pc(uint32_t pc) const;
+    /// The source line of pc from DWARF .debug_line, when the ELF was built with -g.
+    std::optional<SourceLocation> source_at(uint32_t pc) const;
+    /// The segment holding addr, or nullptr.
+    const Segment* segment_at(uint32_t addr) const;
+
+    /// Loader-internal: one row of the DWARF line table (sorted by address).
+    struct LineRow {
+        uint32_t address;
+        uint32_t line;
+        uint32_t file;  ///< index into line_files
+        bool end_sequence;
+    };
+    std::vector<LineRow> line_rows;
+    std::vector<std::string> line_files;
+};
+
+/// Reads and validates an ELF file. Throws tpsim::Error (one line naming the file, the problem
+/// and the fix) for anything tpsim cannot run.
+Program load_elf(const std::string& path);
+
+/// Same, from bytes already in memory; `name` is used in messages.
+Program load_elf(std::span<const uint8_t> image, const std::string& name);
+
+}  // namespace tpsim::core

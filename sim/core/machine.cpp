@@ -1,0 +1,264 @@
+#include "machine.hpp"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+
+#include "error.hpp"
+#include "isa/csr.hpp"
+#include "isa/execute.hpp"
+
+namespace tpsim::core {
+
+namespace {
+
+constexpr uint32_t kExitSyscall = 93;       // a7 value of exit(a0), as in Linux/newlib
+constexpr uint32_t kCauseIllegal = 2;       // mcause values of the privileged spec
+constexpr uint32_t kCauseEcallM = 11;
+constexpr unsigned kA0 = 10, kA7 = 17, kSp = 2;
+
+/// Collects the memory access of one instruction for step(); empty in the fast path.
+struct AccessRecorder {
+    uint32_t address = 0;
+    uint8_t bytes = 0;
+    bool store = false;
+};
+struct NoRecorder {};
+
+}  // namespace
+
+/// The isa::execute environment of one thread. kRecord adds the bookkeeping step() reports; the
+/// fast path instantiates it away.
+template <bool kRecord>
+class ThreadEnv {
+public:
+    ThreadEnv(Machine& machine, uint32_t id)
+        : machine_(machine), memory_(machine.memory_), thread_(machine.threads_[id]),
+          h_(thread_.hart), id_(id), local_(machine.memory_.local_store(id).data()) {}
+
+    template <class T>
+    T load(uint32_t addr) {
+        if constexpr (kRecord) access_ = {addr, uint8_t(sizeof(T)), false};
+        return memory_.load<T>(addr, local_);
+    }
+
+    template <class T>
+    void store(uint32_t addr, T value) {
+        if constexpr (kRecord) access_ = {addr, uint8_t(sizeof(T)), true};
+        memory_.store<T>(addr, value, local_);
+    }
+
+    uint32_t atomic_inc(uint32_t global_register) {
+        if (global_register >= kGlobalRegisters)
+            throw GuestFault{FaultKind::BadGlobalRegister,
+                             fmt::format("uses global register {}, but there are only {} "
+                                         "(0..{})",
+                                         global_register, kGlobalRegisters, kGlobalRegisters - 1),
+                             "use a register index below 256"};
+        return machine_.global_registers_[global_register]++;
+    }
+
+    bool read_csr(uint32_t csr, uint32_t& value) {
+        namespace c = isa::csr;
+        const Machine& m = machine_;
+        const uint32_t per_tm = m.config_.threads_per_tm;
+        // Functionally every instruction takes one cycle, so cycle = instret; the timing model
+        // supplies real cycles. (instret itself is the hart's.)
+        const uint64_t cycles = h_.instret;
+        switch (csr) {
+            case c::kMhartid: value = id_; return true;
+            case c::kNthreads: value = m.thread_count(); return true;
+            case c::kTmid: value = id_ / per_tm; return true;
+            case c::kNtms: value = (m.thread_count() + per_tm - 1) / per_tm; return true;
+            case c::kTpid: value = id_ % per_tm; return true;
+            case c::kTmsize: value = per_tm; return true;
+            case c::kCycle: case c::kMcycle: case c::kTime: value = uint32_t(cycles); return true;
+            case c::kCycleH: case c::kMcycleH: case c::kTimeH:
+                value = uint32_t(cycles >> 32);
+                return true;
+            default: return false;
+        }
+    }
+
+    void ecall(isa::Hart& h) {
+        const uint32_t number = h.reg[kA7];
+        if (number == kExitSyscall) {
+            thread_.state = ThreadState::Exited;
+            thread_.exit_code = int32_t(h.reg[kA0]);
+            if constexpr (kRecord) exited_ = true;
+            return;
+        }
+        if (h.mtvec != 0) return isa::trap(h, kCauseEcallM, 0);
+        throw GuestFault{FaultKind::UnsupportedEcall,
+                         fmt::format("with a7={}; tpsim only implements exit (a7={})", number,
+                                     kExitSyscall),
+                         "call exit through the kernel runtime, or install a trap handler in "
+                         "mtvec"};
+    }
+
+    void ebreak(isa::Hart&) {
+        throw GuestFault{FaultKind::Breakpoint, "stops the thread",
+                         "remove the breakpoint (__builtin_trap / ebreak) or fix the failed "
+                         "check that reached it"};
+    }
+
+    void illegal(isa::Hart& h, const isa::Decoded& d) {
+        const uint32_t word = memory_.code_word(h.pc);
+        const Segment* segment = machine_.program_.segment_at(h.pc);
+        if (!segment || !segment->executable) machine_.fetch_fault(id_, h.pc);
+        if (h.mtvec != 0) return isa::trap(h, kCauseIllegal, word);
+        if (d.op == isa::Op::Illegal)
+            throw GuestFault{FaultKind::IllegalInstruction,
+                             fmt::format("word {:#010x} is not an RV32IMF instruction", word),
+                             "the pc ran into data, or the program uses an extension tpsim lacks "
+                             "(compile with -march=rv32imf)"};
+        const isa::Format format = isa::info(d.op).format;
+        if (format == isa::Format::Csr || format == isa::Format::CsrImm)
+            throw GuestFault{FaultKind::IllegalInstruction,
+                             fmt::format("accesses CSR {:#05x}, which tpsim does not implement "
+                                         "or which is read-only",
+                                         uint32_t(d.imm)),
+                             "use only the CSRs listed in docs/isa.md"};
+        throw GuestFault{FaultKind::IllegalInstruction,
+                         fmt::format("has no valid rounding mode (frm = {})", h.frm),
+                         "set frm to 0..4 (fsrm) or give the instruction a static rounding mode"};
+    }
+
+    AccessRecorder access() const { return access_; }
+    bool exited() const { return exited_; }
+
+private:
+    Machine& machine_;
+    Memory& memory_;
+    Thread& thread_;
+    const isa::Hart& h_;
+    uint32_t id_;
+    uint8_t* local_;
+    [[no_unique_address]] std::conditional_t<kRecord, AccessRecorder, NoRecorder> access_{};
+    bool exited_ = false;
+};
+
+void MachineConfig::validate() const {
+    MemoryConfig{global_bytes, local_store_bytes, threads}.validate();
+    if (threads_per_tm == 0) throw Error("threads per TM must be at least 1");
+    if (quantum == 0) throw Error("scheduler quantum must be at least 1 instruction");
+    if (max_instructions == 0)
+        throw Error("--max-instructions must be at least 1");
+}
+
+Machine::Machine(Program program, const MachineConfig& config)
+    : program_(std::move(program)), config_(config),
+      memory_(program_, MemoryConfig{config.global_bytes, config.local_store_bytes,
+                                     config.threads}) {
+    config_.validate();
+    // Decode the span of all executable segments once; words in gaps between them decode as
+    // illegal and are reported as fetches outside the code.
+    uint32_t lo = UINT32_MAX, hi = 0;
+    for (const Segment& s : program_.segments)
+        if (s.executable) lo = std::min(lo, s.vaddr), hi = std::max(hi, s.end());
+    text_base_ = lo;
+    text_bytes_ = (hi - lo) & ~3u;
+    decoded_.reserve(text_bytes_ / 4);
+    for (uint32_t addr = lo; addr - lo < text_bytes_; addr += 4)
+        decoded_.push_back(isa::decode(memory_.code_word(addr)));
+
+    threads_.resize(config_.threads);
+    for (Thread& t : threads_) {
+        t.hart.pc = program_.entry;
+        t.hart.reg[kSp] = trax::map::kLocalTop;  // the runtime may set it again; asm tests need not
+    }
+}
+
+void Machine::fault(uint32_t id, uint32_t pc, const GuestFault& what) {
+    threads_[id].state = ThreadState::Faulted;
+    std::string where = program_.describe_pc(pc);
+    if (auto source = program_.source_at(pc))
+        where += fmt::format("{}{}:{}", where.empty() ? "" : ", ", source->file, source->line);
+    const Segment* segment = program_.segment_at(pc);
+    const std::string instruction =
+        segment && segment->executable ? isa::disassemble(memory_.code_word(pc), pc) + " " : "";
+    throw Fault(what.kind, id, pc,
+                fmt::format("{} in thread {} at pc {:#010x}{}: {}{}; {}", to_string(what.kind), id,
+                            pc, where.empty() ? "" : " (" + where + ")", instruction, what.detail,
+                            what.hint));
+}
+
+void Machine::fetch_fault(uint32_t id, uint32_t pc) {
+    if (pc % 4 != 0 && pc - text_base_ < text_bytes_)
+        fault(id, pc, {FaultKind::Misaligned, "jump to a pc that is not 4-byte aligned",
+                       "a return address or function pointer is corrupt (stack smashed?)"});
+    fault(id, pc,
+          {FaultKind::FetchOutsideCode,
+           fmt::format("fetch from {:#010x}, outside the code [{:#010x}, {:#010x})", pc,
+                       text_base_, text_base_ + text_bytes_),
+           "a return address or function pointer is null or corrupt (stack smashed?)"});
+}
+
+void Machine::limit_fault(uint32_t id) {
+    fault(id, threads_[id].hart.pc,
+          {FaultKind::InstructionLimit,
+           fmt::format("instruction limit {} reached without exiting", config_.max_instructions),
+           "raise it with --max-instructions, or look for an endless loop"});
+}
+
+template <bool kRecord>
+void Machine::run_quantum(uint32_t id, uint64_t budget, StepRecord* record) {
+    Thread& t = threads_[id];
+    isa::Hart& h = t.hart;
+    ThreadEnv<kRecord> env(*this, id);
+    uint64_t* per_op = counters_.per_op.data();
+    const isa::Decoded* decoded = decoded_.data();
+    uint64_t done = 0;
+    uint32_t pc = h.pc;
+    try {
+        for (; done < budget && t.state == ThreadState::Running; ++done) {
+            pc = h.pc;
+            const uint32_t offset = pc - text_base_;
+            if (offset >= text_bytes_ || offset % 4 != 0) fetch_fault(id, pc);
+            const isa::Decoded& d = decoded[offset / 4];
+            ++per_op[size_t(d.op)];
+            isa::execute(d, h, env);
+            if constexpr (kRecord) {
+                const AccessRecorder a = env.access();
+                *record = {pc, &d, a.address, a.bytes, a.store, h.pc != pc + 4, env.exited()};
+            }
+        }
+    } catch (const GuestFault& f) {
+        t.executed += done;
+        counters_.instructions += done;
+        fault(id, pc, f);
+    }
+    t.executed += done;
+    counters_.instructions += done;
+}
+
+void Machine::run() {
+    std::vector<uint32_t> running;
+    for (uint32_t id = 0; id < thread_count(); ++id)
+        if (threads_[id].state == ThreadState::Running) running.push_back(id);
+    while (!running.empty()) {
+        size_t kept = 0;
+        for (uint32_t id : running) {
+            Thread& t = threads_[id];
+            const uint64_t left = config_.max_instructions - t.executed;
+            if (left == 0) limit_fault(id);
+            run_quantum<false>(id, std::min<uint64_t>(left, config_.quantum), nullptr);
+            if (t.state == ThreadState::Running) running[kept++] = id;
+        }
+        running.resize(kept);
+    }
+}
+
+StepRecord Machine::step(uint32_t id) {
+    Thread& t = threads_.at(id);
+    if (t.state != ThreadState::Running)
+        throw Error(fmt::format("step(): thread {} is not running; the timing model must stop "
+                                "issuing from exited threads",
+                                id));
+    if (t.executed == config_.max_instructions) limit_fault(id);
+    StepRecord record;
+    run_quantum<true>(id, 1, &record);
+    return record;
+}
+
+}  // namespace tpsim::core

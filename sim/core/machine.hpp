@@ -1,0 +1,106 @@
+// The functional machine: T threads running one program over shared memory, deterministically.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "elf_loader.hpp"
+#include "fault.hpp"
+#include "isa/hart.hpp"
+#include "memory.hpp"
+
+namespace tpsim::core {
+
+struct MachineConfig {
+    /// Hardware threads (one per thread processor); each starts at the ELF entry.
+    uint32_t threads = 1;
+    /// Threads per thread multiprocessor; only the tp.tmid/tp.tpid/tp.ntms/tp.tmsize CSRs see it.
+    uint32_t threads_per_tm = 32;
+    /// Bytes of private local store per thread (--local-store).
+    uint32_t local_store_bytes = 4096;
+    /// Bytes of global memory at kGlobalBase (scene image + framebuffer).
+    uint32_t global_bytes = 0;
+    /// Instructions one thread may execute before it faults as a runaway (--max-instructions).
+    uint64_t max_instructions = uint64_t(1) << 32;
+    /// Instructions a thread runs before the functional scheduler moves to the next thread.
+    uint32_t quantum = 1024;
+
+    /// Throws tpsim::Error naming the bad field.
+    void validate() const;
+};
+
+enum class ThreadState : uint8_t { Running, Exited, Faulted };
+
+struct Thread {
+    isa::Hart hart;
+    ThreadState state = ThreadState::Running;
+    int32_t exit_code = 0;   ///< a0 of the exit ecall
+    /// Instructions executed, including the exit ecall and trapping ones (which instret does
+    /// not count); checked against max_instructions.
+    uint64_t executed = 0;
+};
+
+/// What one instruction did, for the timing model (step()).
+struct StepRecord {
+    uint32_t pc = 0;                        ///< address of the instruction
+    const isa::Decoded* insn = nullptr;     ///< its pre-decoded form (registers, FU class)
+    uint32_t mem_address = 0;               ///< effective address when mem_bytes != 0
+    uint8_t mem_bytes = 0;                  ///< access size; 0 = no memory access
+    bool mem_store = false;
+    bool taken = false;                     ///< control left the fall-through path (branch, jump, trap)
+    bool exited = false;                    ///< the instruction ended the thread
+};
+
+struct Counters {
+    uint64_t instructions = 0;
+    std::array<uint64_t, size_t(isa::Op::Count)> per_op{};  ///< indexed by isa::Op
+};
+
+/// Number of global registers for tp.atominc (all start at 0).
+constexpr uint32_t kGlobalRegisters = 256;
+
+class Machine {
+public:
+    Machine(Program program, const MachineConfig& config);
+
+    /// Runs every thread to its exit, round-robin by thread id in fixed quanta, so results never
+    /// depend on anything but the program and the config. Throws Fault on the first guest fault.
+    void run();
+
+    /// Executes one instruction of a running thread and reports what it did. Throws Fault.
+    StepRecord step(uint32_t thread);
+
+    const Program& program() const { return program_; }
+    const MachineConfig& config() const { return config_; }
+    Memory& memory() { return memory_; }
+    const Memory& memory() const { return memory_; }
+    Thread& thread(uint32_t id) { return threads_.at(id); }
+    const Thread& thread(uint32_t id) const { return threads_.at(id); }
+    uint32_t thread_count() const { return uint32_t(threads_.size()); }
+    const Counters& counters() const { return counters_; }
+    uint32_t global_register(uint32_t index) const { return global_registers_.at(index); }
+
+private:
+    template <bool kRecord>
+    friend class ThreadEnv;
+
+    template <bool kRecord>
+    void run_quantum(uint32_t id, uint64_t budget, StepRecord* record);
+    [[noreturn]] void fault(uint32_t id, uint32_t pc, const GuestFault& what);
+    [[noreturn]] void fetch_fault(uint32_t id, uint32_t pc);
+    [[noreturn]] void limit_fault(uint32_t id);
+    uint32_t read_only_csr(uint32_t id, uint32_t csr, bool& known) const;
+
+    Program program_;
+    MachineConfig config_;
+    Memory memory_;
+    uint32_t text_base_ = 0;
+    uint32_t text_bytes_ = 0;
+    std::vector<isa::Decoded> decoded_;   ///< the executable range, one entry per word
+    std::vector<Thread> threads_;
+    std::array<uint32_t, kGlobalRegisters> global_registers_{};
+    Counters counters_;
+};
+
+}  // namespace tpsim::core
