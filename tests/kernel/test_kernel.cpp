@@ -94,7 +94,7 @@ struct Twin {
 
 }  // namespace
 
-TEST_CASE("sections are placed in order, aligned, without overlap") {
+TEST_CASE("kernel: sections are placed in order, aligned, without overlap") {
     layout::SceneHeader h{};
     h.image_width = 7;
     h.image_height = 5;
@@ -145,7 +145,7 @@ struct ElfFile {
 
 }  // namespace
 
-TEST_CASE("kernel ELFs are RV32 executables with only the expected sections and no undefined symbols") {
+TEST_CASE("kernel: kernel ELFs are RV32 executables with only the expected sections and no undefined symbols") {
     const auto name = GENERATE(as<std::string>{}, "hello", "primary_brute");
     INFO("kernel " << name);
     ElfFile f(kKernels + "/" + name + ".elf");
@@ -192,7 +192,7 @@ TEST_CASE("kernel ELFs are RV32 executables with only the expected sections and 
     CHECK(has_text);
 }
 
-TEST_CASE("the native twin runs every thread once with its ids") {
+TEST_CASE("kernel: the native twin runs every thread once with its ids") {
     Twin hello("hello");
     Image image(4, 3, 0, 0, 0);  // 12 pixels, 10 threads: the last two pixels stay untouched
     REQUIRE(hello(image, 10, 3, 4) == "");
@@ -209,7 +209,7 @@ TEST_CASE("the native twin runs every thread once with its ids") {
     }
 }
 
-TEST_CASE("the native twin reports bad accesses and bad contexts instead of crashing") {
+TEST_CASE("kernel: the native twin reports bad accesses and bad contexts instead of crashing") {
     Twin hello("hello");
     Image image(4, 3, 0, 0, 0);
     // Cut global memory off in the middle of the framebuffer: thread 5's store is outside.
@@ -252,7 +252,7 @@ Image lit_triangle_scene(uint32_t flags, bool with_occluder) {
 
 }  // namespace
 
-TEST_CASE("the brute-force kernel shades, shadows and misses as the layout says") {
+TEST_CASE("kernel: the brute-force kernel shades, shadows and misses as the layout says") {
     Twin kernel("primary_brute");
     const double albedo[3] = {0.5, 0.25, 1.0}, ambient[3] = {0.1, 0.2, 0.3};
     // Pixel (1,1): centre ray (-0.25, 0.25, -1) hits z = -2 at p = (-0.5, 0.5, -2), normal +z.
