@@ -55,6 +55,7 @@ public:
 
     /// Requests for the next level in the order they were made; the owner drains it.
     std::deque<OutboundRequest>& outbound() { return outbound_; }
+    const std::deque<OutboundRequest>& outbound() const { return outbound_; }
     bool contains(uint32_t addr) const;
     uint32_t line_of(uint32_t addr) const { return addr & ~(config_.line_bytes - 1); }
     uint32_t bank_of(uint32_t addr) const { return (addr / config_.line_bytes) % config_.banks; }

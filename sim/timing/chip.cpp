@@ -1,0 +1,372 @@
+#include "chip.hpp"
+
+#include "kernel/memory_map.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace tpsim::timing {
+
+namespace {
+
+constexpr uint64_t kNever = UINT64_MAX;
+constexpr uint64_t kDeadlockCycles = 1'000'000;
+constexpr size_t kPools = static_cast<size_t>(Pool::Count);
+constexpr size_t kStalls = static_cast<size_t>(Stall::Count);
+
+bool is_local(uint32_t addr) { return addr >= trax::map::kLocalTop - trax::map::kStackGuard; }
+
+}  // namespace
+
+struct Chip::Tm {
+    struct Tp {
+        std::array<uint64_t, isa::kNumRegs> reg_ready{};  // cycle each register becomes readable
+        std::array<Pool, isa::kNumRegs> reg_producer{};   // pool that will write it
+        StepInfo pending;            // fetched, not yet issued
+        bool has_pending = false;
+        bool done = false;
+        uint64_t fetch_at = 0;       // earliest cycle of the next fetch (branch bubbles)
+        // A granted load/store waiting for its L1 access, from cycle mem_at.
+        bool mem_waiting = false;
+        uint64_t mem_at = 0;
+        MemRequest mem_request;
+        uint32_t lowest_local = trax::map::kLocalTop;  // for the local-store high-water mark
+    };
+    struct Counters {
+        uint64_t instructions = 0;
+        uint64_t active_tp_cycles = 0;  // TP-cycles of threads not yet exited
+        std::array<uint64_t, kStalls> stalls{};
+        std::array<uint64_t, kPools> operand_stalls{};  // by producing pool
+        std::array<uint64_t, size_t(isa::FuClass::Count)> per_class{};
+        uint64_t local_loads = 0;
+        uint64_t local_stores = 0;
+    };
+
+    Tm(const ChipConfig& c, uint32_t id)
+        : id(id), tps(c.chip.tps_per_tm), icache(c.icache, c.chip.tps_per_tm), l1(c.l1) {
+        for (size_t p = 0; p < kPools; ++p)
+            pools.emplace_back(pool_config(c.fu, Pool(p)), c.chip.tps_per_tm);
+    }
+
+    uint32_t id;
+    std::vector<Tp> tps;
+    std::vector<FuPool> pools;
+    ICacheBanks icache;
+    Cache l1;
+    uint32_t rotation = 0;        // TP that goes first this cycle (fetch and L1 priority)
+    uint32_t atomic_sequence = 0;
+    std::vector<AtomicRequest> atomics_out;  // sent this cycle, collected by the chip
+    uint32_t running = 0;
+    Counters counters;
+};
+
+Chip::Chip(const ChipConfig& config, InstructionSource& source)
+    : config_(config),
+      source_(source),
+      dram_(config.dram, config.l2.line_bytes),
+      global_registers_(config.global_registers) {
+    validate(config_);
+    for (uint32_t t = 0; t < config.chip.num_tms; ++t) {
+        tms_.push_back(std::make_unique<Tm>(config, t));
+        tms_.back()->running = config.chip.tps_per_tm;
+    }
+    for (uint32_t g = 0; g < config.num_l2(); ++g) l2s_.emplace_back(config.l2);
+}
+
+Chip::~Chip() = default;
+
+uint64_t Chip::run(uint64_t max_cycles) {
+    uint64_t last_progress = 0, last_progress_cycle = 0;
+    auto busy = [&] {
+        for (const auto& tm : tms_)
+            if (tm->running || tm->l1.outstanding_misses() || !tm->l1.outbound().empty())
+                return true;
+        for (const Cache& l2 : l2s_)
+            if (l2.outstanding_misses() || !l2.outbound().empty()) return true;
+        return !dram_.idle() || !global_registers_.idle();
+    };
+    for (uint64_t now = cycles_; busy(); ++now) {
+        if (now >= max_cycles)
+            throw std::runtime_error(fmt::format(
+                "timing: the chip did not finish within {} cycles; raise the cycle limit",
+                max_cycles));
+        tick_shared(now);
+        for (auto& tm : tms_) tick_tm(*tm, now);
+        cycles_ = now + 1;
+        if (progress_ != last_progress) {
+            last_progress = progress_;
+            last_progress_cycle = now;
+        } else if (now - last_progress_cycle > kDeadlockCycles) {
+            throw std::runtime_error(fmt::format(
+                "timing: deadlock, nothing issued or returned for {} cycles (cycle {}); "
+                "this is a simulator bug, please report it with the config",
+                kDeadlockCycles, now));
+        }
+    }
+    for (const auto& tm : tms_)
+        for (const Tm::Tp& tp : tm->tps)
+            local_store_high_water_ = std::max<uint64_t>(local_store_high_water_,
+                                                         trax::map::kLocalTop - tp.lowest_local);
+    return cycles_;
+}
+
+// Shared parts, in a fixed order: replies DRAM -> L2 -> L1, then requests L1 -> L2 -> DRAM
+// (so a request reaches DRAM in the cycle it leaves L2), then the global registers. TMs are
+// always visited in id order, each TM's queue in FIFO order.
+void Chip::tick_shared(uint64_t now) {
+    MemReply reply;
+    while (dram_.pop_reply(now, reply)) {
+        l2s_[reply.request.source].fill(now, reply.request.addr);
+        ++progress_;
+    }
+    for (Cache& l2 : l2s_)
+        while (l2.pop_reply(now, reply)) tms_[reply.request.source]->l1.fill(now, reply.request.addr);
+
+    for (auto& tm : tms_) {
+        auto& out = tm->l1.outbound();
+        Cache& l2 = l2s_[tm->id / config_.chip.tms_per_l2];
+        while (!out.empty() && out.front().cycle <= now) {
+            MemRequest request = out.front().request;
+            request.source = tm->id;
+            if (!accepted(l2.access(now, request))) break;  // retry next cycle, keep FIFO order
+            out.pop_front();
+        }
+    }
+    for (uint32_t g = 0; g < l2s_.size(); ++g) {
+        auto& out = l2s_[g].outbound();
+        while (!out.empty() && out.front().cycle <= now) {
+            MemRequest request = out.front().request;
+            request.source = g;
+            if (!dram_.enqueue(now, request)) break;
+            out.pop_front();
+        }
+    }
+    dram_.tick(now);
+    for (auto& tm : tms_) {
+        for (const AtomicRequest& a : tm->atomics_out) global_registers_.submit(a);
+        tm->atomics_out.clear();
+    }
+    global_registers_.tick(now);
+    AtomicReply atomic;
+    while (global_registers_.pop_reply(now, atomic)) {
+        Tm::Tp& tp = tms_[atomic.request.tm]->tps[atomic.request.tp];
+        tp.reg_ready[atomic.request.tag] = now;
+        ++progress_;
+    }
+}
+
+void Chip::tick_tm(Tm& tm, uint64_t now) {
+    const uint32_t n = static_cast<uint32_t>(tm.tps.size());
+    MemReply reply;
+    while (tm.l1.pop_reply(now, reply)) {
+        tm.tps[reply.request.source].reg_ready[reply.request.tag] = now;
+        ++progress_;
+    }
+    if (tm.running == 0) return;
+
+    // Granted loads/stores take their L1 bank in rotating order.
+    for (uint32_t k = 0; k < n; ++k) {
+        const uint32_t i = (tm.rotation + k) % n;
+        Tm::Tp& tp = tm.tps[i];
+        if (!tp.mem_waiting || tp.mem_at > now) continue;
+        if (accepted(tm.l1.access(now, tp.mem_request))) tp.mem_waiting = false;
+    }
+
+    // Fetch, scoreboard check, FU request.
+    for (uint32_t k = 0; k < n; ++k) {
+        const uint32_t i = (tm.rotation + k) % n;
+        Tm::Tp& tp = tm.tps[i];
+        if (tp.done) continue;
+        ++tm.counters.active_tp_cycles;
+        if (!tp.has_pending) {
+            if (now < tp.fetch_at) {
+                ++tm.counters.stalls[size_t(Stall::Branch)];
+                continue;
+            }
+            const uint32_t thread = tm.id * n + i;
+            if (!tm.icache.fetch(now, i, source_.next_pc(thread))) {
+                ++tm.counters.stalls[size_t(Stall::FetchConflict)];
+                continue;
+            }
+            tp.pending = source_.step(thread);
+            tp.has_pending = true;
+        }
+        const isa::Decoded& d = *tp.pending.insn;
+        uint64_t operands_at = 0;
+        Pool blocking = Pool::IntAlu;
+        for (uint8_t r : {d.rs1, d.rs2, d.rs3, d.rd}) {  // rd too: no write-after-write reorder
+            if (r == isa::kNoReg || tp.reg_ready[r] <= operands_at) continue;
+            operands_at = tp.reg_ready[r];
+            blocking = tp.reg_producer[r];
+        }
+        if (operands_at > now) {
+            ++tm.counters.stalls[size_t(Stall::Operand)];
+            ++tm.counters.operand_stalls[size_t(blocking)];
+            continue;
+        }
+        const Pool pool = pool_of(isa::info(d.op).fu);
+        if (pool == Pool::LoadStore && tp.mem_waiting && !is_local(tp.pending.mem_address)) {
+            ++tm.counters.stalls[size_t(Stall::MemoryPort)];
+            continue;
+        }
+        tm.pools[size_t(pool)].request(i);
+    }
+
+    // Requests the pools refuse are the FU-busy stalls (the TP keeps its instruction).
+    uint64_t denied_before = 0;
+    for (const FuPool& pool : tm.pools) denied_before += pool.counters().denied;
+    for (size_t p = 0; p < kPools; ++p) {
+        const Pool pool = Pool(p);
+        tm.pools[p].arbitrate(now, [&](uint32_t i, uint64_t ready) {
+            Tm::Tp& tp = tm.tps[i];
+            const StepInfo& s = tp.pending;
+            const isa::Decoded& d = *s.insn;
+            const isa::FuClass fu = isa::info(d.op).fu;
+            ++tm.counters.instructions;
+            ++tm.counters.per_class[size_t(fu)];
+            ++progress_;
+            uint64_t result_at = ready;
+            if (fu == isa::FuClass::Atomic) {
+                result_at = kNever;  // set by the global-register reply
+                tm.atomics_out.push_back({now, tm.id, tm.atomic_sequence++, i, d.rd});
+            } else if (s.mem_bytes != 0 && is_local(s.mem_address)) {
+                tp.lowest_local = std::min(tp.lowest_local, s.mem_address);
+                ++(s.mem_store ? tm.counters.local_stores : tm.counters.local_loads);
+                result_at = ready + config_.tp.local_store_latency;
+            } else if (s.mem_bytes != 0) {
+                tp.mem_waiting = true;
+                tp.mem_at = ready;
+                tp.mem_request = {s.mem_address, i, d.rd, s.mem_store};
+                result_at = kNever;  // set by the L1 reply
+            }
+            if (d.rd != isa::kNoReg && !s.mem_store) {
+                tp.reg_ready[d.rd] = result_at;
+                tp.reg_producer[d.rd] = pool;
+            }
+            const uint32_t bubble = fu == isa::FuClass::Branch
+                                        ? (s.taken ? config_.tp.branch_taken_penalty
+                                                   : config_.tp.branch_not_taken_penalty)
+                                        : 0;
+            tp.fetch_at = now + 1 + bubble;
+            tp.has_pending = false;
+            if (s.exited) {
+                tp.done = true;
+                --tm.running;
+            }
+        });
+    }
+    uint64_t denied_after = 0;
+    for (const FuPool& pool : tm.pools) denied_after += pool.counters().denied;
+    tm.counters.stalls[size_t(Stall::FuBusy)] += denied_after - denied_before;
+    tm.rotation = (tm.rotation + 1) % n;
+}
+
+namespace {
+
+constexpr std::string_view kStallNames[] = {"fetch_conflict", "branch", "fu_busy", "memory_port",
+                                            "operand"};
+static_assert(std::size(kStallNames) == kStalls);
+
+}  // namespace
+
+void Chip::register_stats(stats::Registry& r) const {
+    const double threads = double(config_.chip.num_tms) * config_.chip.tps_per_tm;
+    for (const auto& tm_ptr : tms_) {
+        const Tm& tm = *tm_ptr;
+        const std::string p = fmt::format("tm{}", tm.id);
+        r.add_counter(p + "/instructions", tm.counters.instructions, "instructions issued");
+        r.add_counter(p + "/active_tp_cycles", tm.counters.active_tp_cycles,
+                      "TP-cycles of threads that had not exited (= issued + stalled)",
+                      "TP-cycles");
+        for (size_t s = 0; s < kStalls; ++s)
+            r.add_counter(fmt::format("{}/stalls/{}", p, kStallNames[s]), tm.counters.stalls[s],
+                          "TP-cycles without issue, by cause (docs/statistics.md)", "TP-cycles");
+        for (size_t q = 0; q < kPools; ++q)
+            r.add_counter(fmt::format("{}/stalls/operand_from/{}", p, to_string(Pool(q))),
+                          tm.counters.operand_stalls[q],
+                          "operand stalls waiting on a result of this pool", "TP-cycles");
+        for (size_t c = 0; c < size_t(isa::FuClass::Count); ++c)
+            r.add_counter(fmt::format("{}/class/{}", p, isa::to_string(isa::FuClass(c))),
+                          tm.counters.per_class[c], "instructions issued of this FU class");
+        for (size_t q = 0; q < kPools; ++q)
+            tm.pools[q].register_stats(r, fmt::format("{}/fu/{}", p, to_string(Pool(q))));
+        tm.icache.register_stats(r, p + "/icache");
+        tm.l1.register_stats(r, p + "/l1");
+        r.add_counter(p + "/local_store/loads", tm.counters.local_loads, "local-store loads");
+        r.add_counter(p + "/local_store/stores", tm.counters.local_stores, "local-store stores");
+    }
+    for (size_t g = 0; g < l2s_.size(); ++g) l2s_[g].register_stats(r, fmt::format("l2/{}", g));
+    dram_.register_stats(r, "dram");
+    global_registers_.register_stats(r, "global_registers");
+
+    r.add_counter("chip/cycles", cycles_, "cycles until every thread exited and memory drained",
+                  "cycles");
+    const double clock_hz = config_.chip.clock_mhz * 1e6;
+    r.add_derived("chip/frame_seconds", [this, clock_hz] { return double(cycles_) / clock_hz; },
+                  "simulated time at chip.clock_mhz", "s");
+    r.add_derived("chip/fps", [this, clock_hz] { return cycles_ ? clock_hz / double(cycles_) : 0; },
+                  "frames per second if one run is one frame", "1/s");
+    r.add_sum("chip/instructions", "*/instructions", "instructions issued, all TMs");
+    r.add_derived("chip/issue_rate",
+                  [&r, threads, this] {
+                      return cycles_ ? r.value("chip/instructions") / (double(cycles_) * threads)
+                                     : 0.0;
+                  },
+                  "instructions per thread per cycle (1 = every TP issues every cycle)");
+    r.add_sum("chip/active_tp_cycles", "*/active_tp_cycles", "TP-cycles before exit, all TMs",
+              "TP-cycles");
+    for (std::string_view stall : kStallNames)
+        r.add_sum(fmt::format("chip/stalls/{}", stall), fmt::format("*/stalls/{}", stall),
+                  "TP-cycles without issue by cause, all TMs", "TP-cycles");
+    for (size_t q = 0; q < kPools; ++q) {
+        const std::string_view pool = to_string(Pool(q));
+        r.add_sum(fmt::format("chip/stalls/operand_from/{}", pool),
+                  fmt::format("*/stalls/operand_from/{}", pool),
+                  "operand stalls by producing pool, all TMs", "TP-cycles");
+    }
+    for (size_t c = 0; c < size_t(isa::FuClass::Count); ++c) {
+        const std::string_view cls = isa::to_string(isa::FuClass(c));
+        r.add_sum(fmt::format("chip/class/{}", cls), fmt::format("*/class/{}", cls),
+                  "instructions of this FU class, all TMs");
+    }
+    for (size_t q = 0; q < kPools; ++q) {
+        const std::string_view pool = to_string(Pool(q));
+        const std::string busy = fmt::format("chip/fu/{}/unit_busy_cycles", pool);
+        r.add_sum(busy, fmt::format("*/fu/{}/unit_busy_cycles", pool),
+                  "unit-cycles occupied, all TMs", "unit-cycles");
+        const double units =
+            double(pool_config(config_.fu, Pool(q)).count) * config_.chip.num_tms;
+        r.add_derived(fmt::format("chip/fu/{}/utilisation", pool),
+                      [&r, busy, units, this] {
+                          return cycles_ ? r.value(busy) / (units * double(cycles_)) : 0.0;
+                      },
+                      "busy unit-cycles / (units x cycles)");
+    }
+    for (std::string_view level : {"l1", "l2"}) {
+        const std::string from = level == "l1" ? "*/l1/" : "l2/*/";
+        for (std::string_view leaf : {"reads", "writes", "hits", "misses", "merged_misses",
+                                      "bank_conflicts", "mshr_full"})
+            r.add_sum(fmt::format("chip/{}/{}", level, leaf), from + std::string(leaf),
+                      fmt::format("{} {}, all caches", level, leaf), "accesses");
+        r.add_ratio(fmt::format("chip/{}/hit_rate", level), fmt::format("chip/{}/hits", level),
+                    fmt::format("chip/{}/reads", level), "hits / reads");
+    }
+    r.add_derived("chip/dram/bandwidth_bytes_per_cycle",
+                  [&r, this] {
+                      return cycles_ ? (r.value("dram/bytes_read") + r.value("dram/bytes_written")) /
+                                           double(cycles_)
+                                     : 0.0;
+                  },
+                  "achieved DRAM bandwidth", "B/cycle");
+    r.add_derived("chip/dram/bandwidth_gbps",
+                  [&r, clock_hz] {
+                      return r.value("chip/dram/bandwidth_bytes_per_cycle") * clock_hz / 1e9;
+                  },
+                  "achieved DRAM bandwidth at chip.clock_mhz", "GB/s");
+    r.add_counter("chip/local_store_high_water", local_store_high_water_,
+                  "largest local-store (stack) footprint of any thread", "B");
+}
+
+}  // namespace tpsim::timing

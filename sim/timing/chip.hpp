@@ -1,0 +1,89 @@
+// The cycle loop of the whole chip: thread processors (in-order, single issue, scoreboard over
+// the unified 65-entry register file), I-cache fetch banks, FU pools, L1 per TM, L2 per group
+// of TMs, DRAM and the global-register unit.
+//
+// Functional-first: the timing model asks its InstructionSource to execute one instruction when
+// a TP fetches it, and then only decides when that instruction issues and when its result is
+// ready. Each TM touches only its own state; traffic to L2, DRAM and the global registers moves
+// through cycle-stamped queues processed in a fixed order (TM id, then FIFO order), so results
+// never depend on host scheduling.
+#pragma once
+#include "isa/isa.hpp"
+#include "stats/registry.hpp"
+#include "timing/cache.hpp"
+#include "timing/config.hpp"
+#include "timing/dram.hpp"
+#include "timing/fu_pool.hpp"
+#include "timing/global_registers.hpp"
+
+#include <array>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <vector>
+
+namespace tpsim::timing {
+
+/// What one executed instruction did (mirrors sim/core's StepRecord).
+struct StepInfo {
+    uint32_t pc = 0;
+    const isa::Decoded* insn = nullptr;
+    uint32_t mem_address = 0;
+    uint8_t mem_bytes = 0;  ///< 0 = no memory access
+    bool mem_store = false;
+    bool taken = false;     ///< control left the fall-through path
+    bool exited = false;    ///< the thread ended with this instruction
+};
+
+/// The functional side, as the timing model sees it. Threads are numbered tm * tps_per_tm + tp.
+class InstructionSource {
+public:
+    virtual ~InstructionSource() = default;
+    /// Address of the next instruction thread `thread` will execute.
+    virtual uint32_t next_pc(uint32_t thread) const = 0;
+    /// Executes that instruction and reports it.
+    virtual StepInfo step(uint32_t thread) = 0;
+};
+
+/// Why a TP did not issue in a cycle (exactly one cause per TP-cycle).
+enum class Stall : uint8_t {
+    FetchConflict,  ///< lost the I-cache bank to another thread
+    Branch,         ///< bubble after a branch (tp.branch_*_penalty)
+    FuBusy,         ///< operands ready but every unit of the pool was taken
+    MemoryPort,     ///< a previous load/store still waits for an L1 bank or MSHR
+    Operand,        ///< an operand is not ready; attributed to its producing pool below
+    Count
+};
+
+class Chip {
+public:
+    Chip(const ChipConfig& config, InstructionSource& source);
+    ~Chip();
+
+    /// Runs until every thread has exited and all memory traffic has drained; returns the
+    /// cycle count. Throws std::runtime_error if nothing progresses for a long time (deadlock)
+    /// or `max_cycles` pass.
+    uint64_t run(uint64_t max_cycles = UINT64_MAX);
+
+    uint64_t cycles() const { return cycles_; }
+    /// Registers every counter under tm<i>/..., l2/<j>/..., dram/..., global_registers/...,
+    /// and chip-wide sums under chip/... . The chip and `registry` must outlive the printing.
+    void register_stats(stats::Registry& registry) const;
+
+private:
+    struct Tm;
+    void tick_shared(uint64_t now);
+    void tick_tm(Tm& tm, uint64_t now);
+
+    ChipConfig config_;
+    InstructionSource& source_;
+    std::vector<std::unique_ptr<Tm>> tms_;
+    std::vector<Cache> l2s_;
+    Dram dram_;
+    GlobalRegisterUnit global_registers_;
+    uint64_t cycles_ = 0;
+    uint64_t progress_ = 0;  // bumped whenever anything issues or returns
+    uint64_t local_store_high_water_ = 0;  // bytes, max over threads
+};
+
+}  // namespace tpsim::timing
