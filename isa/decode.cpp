@@ -18,40 +18,47 @@ constexpr int32_t sign_extend(uint32_t value, unsigned width) {
 /// Maps a 5-bit register field into the unified file (see isa.hpp).
 constexpr uint8_t unified(uint32_t field, RegKind kind, bool is_destination) {
     switch (kind) {
-        case RegKind::Int: return field == 0 && is_destination ? kSink : uint8_t(field);
-        case RegKind::Fp: return uint8_t(kFpBase + field);
-        case RegKind::None: break;
+    case RegKind::Int:
+        return field == 0 && is_destination ? kSink : uint8_t(field);
+    case RegKind::Fp:
+        return uint8_t(kFpBase + field);
+    case RegKind::None:
+        break;
     }
     return kNoReg;
 }
 
 int32_t immediate(uint32_t word, Format format, uint32_t mask) {
     switch (format) {
-        case Format::I:
-            // Shifts pin funct7 in the mask; their immediate is the 5-bit shamt.
-            if ((mask >> 25) == 0x7f) return int32_t(bits(word, 24, 20));
-            return sign_extend(bits(word, 31, 20), 12);
-        case Format::S: return sign_extend(bits(word, 31, 25) << 5 | bits(word, 11, 7), 12);
-        case Format::B:
-            return sign_extend(bits(word, 31, 31) << 12 | bits(word, 7, 7) << 11 | bits(word, 30, 25) << 5 |
-                                   bits(word, 11, 8) << 1,
-                               13);
-        case Format::U: return int32_t(word & 0xffff'f000);
-        case Format::J:
-            return sign_extend(bits(word, 31, 31) << 20 | bits(word, 19, 12) << 12 | bits(word, 20, 20) << 11 |
-                                   bits(word, 30, 21) << 1,
-                               21);
-        case Format::Csr:
-        case Format::CsrImm:
-        case Format::Fence: return int32_t(bits(word, 31, 20));
-        case Format::R:
-        case Format::R4:
-        case Format::System: break;
+    case Format::I:
+        // Shifts pin funct7 in the mask; their immediate is the 5-bit shamt.
+        if ((mask >> 25) == 0x7f) return int32_t(bits(word, 24, 20));
+        return sign_extend(bits(word, 31, 20), 12);
+    case Format::S:
+        return sign_extend(bits(word, 31, 25) << 5 | bits(word, 11, 7), 12);
+    case Format::B:
+        return sign_extend(bits(word, 31, 31) << 12 | bits(word, 7, 7) << 11 |
+                               bits(word, 30, 25) << 5 | bits(word, 11, 8) << 1,
+                           13);
+    case Format::U:
+        return int32_t(word & 0xffff'f000);
+    case Format::J:
+        return sign_extend(bits(word, 31, 31) << 20 | bits(word, 19, 12) << 12 |
+                               bits(word, 20, 20) << 11 | bits(word, 30, 21) << 1,
+                           21);
+    case Format::Csr:
+    case Format::CsrImm:
+    case Format::Fence:
+        return int32_t(bits(word, 31, 20));
+    case Format::R:
+    case Format::R4:
+    case Format::System:
+        break;
     }
     return 0;
 }
 
-}  // namespace
+} // namespace
 
 Decoded decode(uint32_t word) {
     Decoded d;
@@ -75,4 +82,4 @@ Decoded decode(uint32_t word) {
     return d;
 }
 
-}  // namespace tpsim::isa
+} // namespace tpsim::isa

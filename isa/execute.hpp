@@ -23,7 +23,8 @@ constexpr int32_t rem(int32_t a, int32_t b) {
 }
 
 /// misa: RV32 (MXL=1) with I, M, F and X (non-standard extensions present).
-constexpr uint32_t kMisa = 1u << 30 | 1u << ('I' - 'A') | 1u << ('M' - 'A') | 1u << ('F' - 'A') | 1u << ('X' - 'A');
+constexpr uint32_t kMisa =
+    1u << 30 | 1u << ('I' - 'A') | 1u << ('M' - 'A') | 1u << ('F' - 'A') | 1u << ('X' - 'A');
 /// mstatus bits that mret touches (machine mode only: MPP reads back as M).
 constexpr uint32_t kMie = 1u << 3, kMpie = 1u << 7, kMpp = 3u << 11;
 
@@ -35,15 +36,24 @@ inline void mret(Hart& h) {
 /// Hart-held CSR storage, or nullptr if the CSR is not kept in the hart.
 inline uint32_t* hart_csr(Hart& h, uint32_t number) {
     switch (number) {
-        case csr::kMstatus: return &h.mstatus;
-        case csr::kMtvec: return &h.mtvec;
-        case csr::kMepc: return &h.mepc;
-        case csr::kMcause: return &h.mcause;
-        case csr::kMtval: return &h.mtval;
-        case csr::kMscratch: return &h.mscratch;
-        case csr::kMie: return &h.mie;
-        case csr::kMip: return &h.mip;
-        default: return nullptr;
+    case csr::kMstatus:
+        return &h.mstatus;
+    case csr::kMtvec:
+        return &h.mtvec;
+    case csr::kMepc:
+        return &h.mepc;
+    case csr::kMcause:
+        return &h.mcause;
+    case csr::kMtval:
+        return &h.mtval;
+    case csr::kMscratch:
+        return &h.mscratch;
+    case csr::kMie:
+        return &h.mie;
+    case csr::kMip:
+        return &h.mip;
+    default:
+        return nullptr;
     }
 }
 
@@ -54,50 +64,57 @@ enum class CsrWrite { Replace, Set, Clear };
 /// retired instructions (the CSR instruction itself not yet included); cycle, mhartid and the
 /// tpsim CSRs come from the environment.
 template <class Env>
-bool csr_access(uint32_t number, uint32_t source, CsrWrite kind, bool writes, uint32_t& old, Hart& h, Env& env) {
+bool csr_access(uint32_t number, uint32_t source, CsrWrite kind, bool writes, uint32_t& old,
+                Hart& h, Env& env) {
     if (writes && csr::is_read_only(number)) return false;
     auto combine = [&](uint32_t value) {
         switch (kind) {
-            case CsrWrite::Replace: return source;
-            case CsrWrite::Set: return value | source;
-            case CsrWrite::Clear: return value & ~source;
+        case CsrWrite::Replace:
+            return source;
+        case CsrWrite::Set:
+            return value | source;
+        case CsrWrite::Clear:
+            return value & ~source;
         }
         return value;
     };
     switch (number) {
-        case csr::kFflags:
-            old = h.fflags;
-            if (writes) h.fflags = combine(old) & 0x1f;
-            return true;
-        case csr::kFrm:
-            old = h.frm;
-            if (writes) h.frm = combine(old) & 0x7;
-            return true;
-        case csr::kFcsr:
-            old = h.frm << 5 | h.fflags;
-            if (writes) {
-                const uint32_t value = combine(old);
-                h.fflags = value & 0x1f;
-                h.frm = (value >> 5) & 0x7;
-            }
-            return true;
-        case csr::kInstret:
-        case csr::kMinstret:
-            old = uint32_t(h.instret);
-            if (writes) h.instret = (h.instret & ~uint64_t{0xffff'ffff}) | combine(old);
-            return true;
-        case csr::kInstretH:
-        case csr::kMinstretH:
-            old = uint32_t(h.instret >> 32);
-            if (writes) h.instret = uint64_t{combine(old)} << 32 | uint32_t(h.instret);
-            return true;
-        case csr::kMisa:  // WARL: writes are ignored
-            old = kMisa;
-            return true;
-        case csr::kMvendorid:
-        case csr::kMarchid:
-        case csr::kMimpid: old = 0; return true;
-        default: break;
+    case csr::kFflags:
+        old = h.fflags;
+        if (writes) h.fflags = combine(old) & 0x1f;
+        return true;
+    case csr::kFrm:
+        old = h.frm;
+        if (writes) h.frm = combine(old) & 0x7;
+        return true;
+    case csr::kFcsr:
+        old = h.frm << 5 | h.fflags;
+        if (writes) {
+            const uint32_t value = combine(old);
+            h.fflags = value & 0x1f;
+            h.frm = (value >> 5) & 0x7;
+        }
+        return true;
+    case csr::kInstret:
+    case csr::kMinstret:
+        old = uint32_t(h.instret);
+        if (writes) h.instret = (h.instret & ~uint64_t{0xffff'ffff}) | combine(old);
+        return true;
+    case csr::kInstretH:
+    case csr::kMinstretH:
+        old = uint32_t(h.instret >> 32);
+        if (writes) h.instret = uint64_t{combine(old)} << 32 | uint32_t(h.instret);
+        return true;
+    case csr::kMisa: // WARL: writes are ignored
+        old = kMisa;
+        return true;
+    case csr::kMvendorid:
+    case csr::kMarchid:
+    case csr::kMimpid:
+        old = 0;
+        return true;
+    default:
+        break;
     }
     if (uint32_t* field = hart_csr(h, number)) {
         old = *field;
@@ -108,14 +125,10 @@ bool csr_access(uint32_t number, uint32_t source, CsrWrite kind, bool writes, ui
     return !writes && env.read_csr(number, old);
 }
 
-/// `uses_rm` of the table's operand spec, at compile time.
-constexpr bool uses_rounding_mode(const char* spec) { return spec[3] == 'r'; }
-
-}  // namespace detail
+} // namespace detail
 
 /// Executes one pre-decoded instruction (contract in hart.hpp).
-template <class Env>
-inline void execute(const Decoded& d, Hart& h, Env& env) {
+template <class Env> inline void execute(const Decoded& d, Hart& h, Env& env) {
     uint32_t npc = h.pc + 4;
 
 // Helper vocabulary of the instruction bodies (see instructions.def).
@@ -132,34 +145,36 @@ inline void execute(const Decoded& d, Hart& h, Env& env) {
 #define WRITE_RD(value) (h.reg[d.rd] = uint32_t(value))
 #define LOAD(type) env.template load<type>(RS1 + IMM)
 #define STORE(type, value) env.template store<type>(RS1 + IMM, type(value))
-#define CSR(source, kind, writes)                                                              \
-    do {                                                                                       \
-        uint32_t old = 0;                                                                      \
-        if (!detail::csr_access(uint32_t(IMM), uint32_t(source), kind, writes, old, h, env)) { \
-            env.illegal(h, d);                                                                 \
-            return;                                                                            \
-        }                                                                                      \
-        WRITE_RD(old);                                                                         \
+#define CSR(source, kind, writes)                                                                  \
+    do {                                                                                           \
+        uint32_t old = 0;                                                                          \
+        if (!detail::csr_access(uint32_t(IMM), uint32_t(source), kind, writes, old, h, env)) {     \
+            env.illegal(h, d);                                                                     \
+            return;                                                                                \
+        }                                                                                          \
+        WRITE_RD(old);                                                                             \
     } while (false)
 
     switch (d.op) {
-#define TPSIM_INSN(name, mnemonic, match, mask, format, fu, operands, ...) \
-    case Op::name: {                                                       \
-        [[maybe_unused]] unsigned rm = 0;                                  \
-        if constexpr (detail::uses_rounding_mode(operands)) {              \
-            rm = d.rm == fpu::DYN ? h.frm : d.rm;                          \
-            if (rm > fpu::RMM) {                                           \
-                env.illegal(h, d);                                         \
-                return;                                                    \
-            }                                                              \
-        }                                                                  \
-        __VA_ARGS__;                                                       \
-        break;                                                             \
+#define TPSIM_INSN(name, mnemonic, match, mask, format, fu, operands, ...)                         \
+    case Op::name: {                                                                               \
+        [[maybe_unused]] unsigned rm = 0;                                                          \
+        if constexpr (operand_info(operands).rounding_mode) {                                      \
+            rm = d.rm == fpu::DYN ? h.frm : d.rm;                                                  \
+            if (rm > fpu::RMM) {                                                                   \
+                env.illegal(h, d);                                                                 \
+                return;                                                                            \
+            }                                                                                      \
+        }                                                                                          \
+        __VA_ARGS__;                                                                               \
+        break;                                                                                     \
     }
 #include "instructions.def"
 #undef TPSIM_INSN
-        case Op::Illegal:
-        case Op::Count: env.illegal(h, d); return;
+    case Op::Illegal:
+    case Op::Count:
+        env.illegal(h, d);
+        return;
     }
 
 #undef RS1
@@ -181,4 +196,4 @@ inline void execute(const Decoded& d, Hart& h, Env& env) {
     ++h.instret;
 }
 
-}  // namespace tpsim::isa
+} // namespace tpsim::isa

@@ -8,7 +8,7 @@
 #include "fpu.hpp"
 
 #include <cmath>
-#include <cstring>
+#include <type_traits>
 #include <xmmintrin.h>
 
 namespace tpsim::isa::fpu {
@@ -25,18 +25,20 @@ uint32_t riscv_flags(uint32_t mxcsr) {
            ((mxcsr & 0x10) ? UF : 0) | ((mxcsr & 0x20) ? NX : 0);
 }
 
-template <class T>
-inline void opaque(T& value) {
-    asm volatile("" : "+x"(value));
+/// The value, hidden from the optimizer: an operation on it cannot move above this point.
+template <class T> inline T opaque(T value) {
+    if constexpr (std::is_integral_v<T>)
+        asm volatile("" : "+r"(value));
+    else
+        asm volatile("" : "+x"(value));
+    return value;
 }
 
 /// Runs `op` (float or double) in x86 rounding mode `rm` (0..3) with cleared host flags, adds the
 /// raised flags to fflags and restores the host default mode.
-template <class Op>
-inline auto run_rounded(unsigned rm, uint32_t& fflags, Op op) {
+template <class Op> inline auto run_rounded(unsigned rm, uint32_t& fflags, Op op) {
     _mm_setcsr(kMxcsrDefault | kMxcsrRounding[rm]);
-    auto result = op();
-    opaque(result);
+    const auto result = opaque(op());
     const uint32_t mxcsr = _mm_getcsr();
     if (rm != RNE) _mm_setcsr(kMxcsrDefault);
     fflags |= riscv_flags(mxcsr);
@@ -51,12 +53,13 @@ uint32_t canonical(float result) {
 /// lies at or beyond the midpoint between t and its neighbour away from zero. That midpoint has
 /// 25 significant bits, so it is exact in double, and `exact_rtz` (the op evaluated in double
 /// with RTZ) compares against it exactly as the infinitely precise result would.
-uint32_t round_ties_away(float truncated, uint32_t truncated_flags, double exact_rtz, uint32_t& fflags) {
+uint32_t round_ties_away(float truncated, uint32_t truncated_flags, double exact_rtz,
+                         uint32_t& fflags) {
     uint32_t bits = std::bit_cast<uint32_t>(truncated);
     if ((truncated_flags & NX) && std::isfinite(truncated)) {
-        const uint32_t away = bits + 1;  // next magnitude up; FLT_MAX + 1 ulp is +-inf
+        const uint32_t away = bits + 1; // next magnitude up; FLT_MAX + 1 ulp is +-inf
         const double midpoint = (away & 0x7fff'ffff) == 0x7f80'0000
-                                    ? 0x1.ffffffp+127  // halfway between FLT_MAX and 2^128
+                                    ? 0x1.ffffffp+127 // halfway between FLT_MAX and 2^128
                                     : (double(truncated) + double(std::bit_cast<float>(away))) / 2;
         if (std::fabs(exact_rtz) >= std::fabs(midpoint)) {
             bits = away;
@@ -64,7 +67,8 @@ uint32_t round_ties_away(float truncated, uint32_t truncated_flags, double exact
         }
         // Tininess after rounding, at RMM: results that round (unbounded exponent) up to 2^-126
         // are not tiny although RTZ found them tiny.
-        if ((truncated_flags & UF) && std::fabs(exact_rtz) >= 0x1p-126 - 0x1p-151) truncated_flags &= ~uint32_t{UF};
+        if ((truncated_flags & UF) && std::fabs(exact_rtz) >= 0x1p-126 - 0x1p-151)
+            truncated_flags &= ~uint32_t{UF};
     }
     fflags |= truncated_flags;
     return std::isnan(truncated) ? kCanonicalNaN : bits;
@@ -83,56 +87,60 @@ inline uint32_t rounded(unsigned rm, uint32_t& fflags, Single single, Wide wide)
     return round_ties_away(truncated, truncated_flags, exact_rtz, fflags);
 }
 
-float as_float(uint32_t bits) { return std::bit_cast<float>(bits); }
+float as_float(uint32_t bits) {
+    return std::bit_cast<float>(bits);
+}
 
-}  // namespace
+/// A two-operand rounding operation, `op` written once for float and double.
+template <class Op> uint32_t binary(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags, Op op) {
+    const float x = as_float(a), y = as_float(b);
+    return rounded(
+        rm, fflags, [&] { return op(opaque(x), opaque(y)); },
+        [&] { return op(opaque(double(x)), opaque(double(y))); });
+}
+
+} // namespace
 
 uint32_t add(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags) {
-    float x = as_float(a), y = as_float(b);
-    return rounded(rm, fflags, [&] { opaque(x); opaque(y); return x + y; },
-                   [&] { double p = x, q = y; opaque(p); opaque(q); return p + q; });
+    return binary(a, b, rm, fflags, [](auto x, auto y) { return x + y; });
 }
 
 uint32_t sub(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags) {
-    float x = as_float(a), y = as_float(b);
-    return rounded(rm, fflags, [&] { opaque(x); opaque(y); return x - y; },
-                   [&] { double p = x, q = y; opaque(p); opaque(q); return p - q; });
+    return binary(a, b, rm, fflags, [](auto x, auto y) { return x - y; });
 }
 
 uint32_t mul(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags) {
-    float x = as_float(a), y = as_float(b);
-    return rounded(rm, fflags, [&] { opaque(x); opaque(y); return x * y; },
-                   [&] { double p = x, q = y; opaque(p); opaque(q); return p * q; });
+    return binary(a, b, rm, fflags, [](auto x, auto y) { return x * y; });
 }
 
 uint32_t div(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags) {
-    float x = as_float(a), y = as_float(b);
-    return rounded(rm, fflags, [&] { opaque(x); opaque(y); return x / y; },
-                   [&] { double p = x, q = y; opaque(p); opaque(q); return p / q; });
+    return binary(a, b, rm, fflags, [](auto x, auto y) { return x / y; });
 }
 
 uint32_t sqrt(uint32_t a, unsigned rm, uint32_t& fflags) {
-    float x = as_float(a);
-    return rounded(rm, fflags, [&] { opaque(x); return std::sqrt(x); },
-                   [&] { double p = x; opaque(p); return std::sqrt(p); });
+    const float x = as_float(a);
+    return rounded(
+        rm, fflags, [&] { return std::sqrt(opaque(x)); },
+        [&] { return std::sqrt(opaque(double(x))); });
 }
 
 uint32_t fma(uint32_t a, uint32_t b, uint32_t c, unsigned rm, uint32_t& fflags) {
-    float x = as_float(a), y = as_float(b), z = as_float(c);
+    const float x = as_float(a), y = as_float(b), z = as_float(c);
     // RISC-V requires NV for inf*0 even when the addend is a quiet NaN (IEEE leaves it open).
     if (((std::isinf(x) && y == 0) || (x == 0 && std::isinf(y))) && std::isnan(z)) fflags |= NV;
-    return rounded(rm, fflags, [&] { opaque(x); opaque(y); opaque(z); return std::fma(x, y, z); },
-                   [&] { double p = x, q = y, r = z; opaque(p); opaque(q); opaque(r); return std::fma(p, q, r); });
+    return rounded(
+        rm, fflags, [&] { return std::fma(opaque(x), opaque(y), opaque(z)); },
+        [&] { return std::fma(opaque(double(x)), opaque(double(y)), opaque(double(z))); });
 }
 
 uint32_t cvt_s_w(int32_t a, unsigned rm, uint32_t& fflags) {
-    return rounded(rm, fflags, [&] { int32_t v = a; asm volatile("" : "+r"(v)); return float(v); },
-                   [&] { return double(a); });
+    return rounded(
+        rm, fflags, [&] { return float(opaque(a)); }, [&] { return double(a); });
 }
 
 uint32_t cvt_s_wu(uint32_t a, unsigned rm, uint32_t& fflags) {
-    return rounded(rm, fflags, [&] { uint32_t v = a; asm volatile("" : "+r"(v)); return float(v); },
-                   [&] { return double(a); });
+    return rounded(
+        rm, fflags, [&] { return float(opaque(a)); }, [&] { return double(a); });
 }
 
 namespace {
@@ -144,20 +152,24 @@ double round_to_integer(float value, unsigned rm, bool& inexact) {
     inexact = fraction != 0;
     const double away = truncated + (v < 0 ? -1 : 1);
     switch (rm) {
-        case RTZ: return truncated;
-        case RDN: return fraction < 0 ? truncated - 1 : truncated;
-        case RUP: return fraction > 0 ? truncated + 1 : truncated;
-        case RMM: return std::fabs(fraction) >= 0.5 ? away : truncated;
-        default:  // RNE
-            if (std::fabs(fraction) > 0.5) return away;
-            if (std::fabs(fraction) < 0.5) return truncated;
-            return std::fmod(truncated, 2) == 0 ? truncated : away;
+    case RTZ:
+        return truncated;
+    case RDN:
+        return fraction < 0 ? truncated - 1 : truncated;
+    case RUP:
+        return fraction > 0 ? truncated + 1 : truncated;
+    case RMM:
+        return std::fabs(fraction) >= 0.5 ? away : truncated;
+    default: // RNE
+        if (std::fabs(fraction) > 0.5) return away;
+        if (std::fabs(fraction) < 0.5) return truncated;
+        return std::fmod(truncated, 2) == 0 ? truncated : away;
     }
 }
 
 /// Shared by fcvt.w.s and fcvt.wu.s: saturate to [lowest, highest] with NV, else NX if inexact.
-uint32_t convert_to_integer(uint32_t a, unsigned rm, uint32_t& fflags, double lowest, double highest,
-                            uint32_t nan_result) {
+uint32_t convert_to_integer(uint32_t a, unsigned rm, uint32_t& fflags, double lowest,
+                            double highest, uint32_t nan_result) {
     if (is_nan(a)) return fflags |= NV, nan_result;
     const float value = as_float(a);
     if (std::isinf(value)) return fflags |= NV, uint32_t(int64_t(value < 0 ? lowest : highest));
@@ -169,7 +181,7 @@ uint32_t convert_to_integer(uint32_t a, unsigned rm, uint32_t& fflags, double lo
     return uint32_t(int64_t(r));
 }
 
-}  // namespace
+} // namespace
 
 uint32_t cvt_w_s(uint32_t a, unsigned rm, uint32_t& fflags) {
     return convert_to_integer(a, rm, fflags, -2147483648.0, 2147483647.0, 0x7fff'ffff);
@@ -179,4 +191,4 @@ uint32_t cvt_wu_s(uint32_t a, unsigned rm, uint32_t& fflags) {
     return convert_to_integer(a, rm, fflags, 0.0, 4294967295.0, 0xffff'ffff);
 }
 
-}  // namespace tpsim::isa::fpu
+} // namespace tpsim::isa::fpu

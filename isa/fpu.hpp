@@ -31,9 +31,15 @@ uint32_t cvt_w_s(uint32_t a, unsigned rm, uint32_t& fflags);
 uint32_t cvt_wu_s(uint32_t a, unsigned rm, uint32_t& fflags);
 
 // Exact operations: bit logic only, no host FP state involved.
-constexpr bool is_nan(uint32_t a) { return (a & 0x7fff'ffff) > 0x7f80'0000; }
-constexpr bool is_signaling_nan(uint32_t a) { return is_nan(a) && !(a & 0x0040'0000); }
-constexpr bool is_zero(uint32_t a) { return (a & 0x7fff'ffff) == 0; }
+constexpr bool is_nan(uint32_t a) {
+    return (a & 0x7fff'ffff) > 0x7f80'0000;
+}
+constexpr bool is_signaling_nan(uint32_t a) {
+    return is_nan(a) && !(a & 0x0040'0000);
+}
+constexpr bool is_zero(uint32_t a) {
+    return (a & 0x7fff'ffff) == 0;
+}
 
 /// Orders non-NaN floats as the integers -|x| < ... < +|x|, with -0 below +0.
 constexpr int64_t total_key(uint32_t a) {
@@ -49,11 +55,17 @@ constexpr uint32_t min_max(uint32_t a, uint32_t b, bool want_max, uint32_t& ffla
     if (is_nan(b)) return a;
     return (total_key(a) < total_key(b)) == want_max ? b : a;
 }
-constexpr uint32_t min(uint32_t a, uint32_t b, uint32_t& fflags) { return min_max(a, b, false, fflags); }
-constexpr uint32_t max(uint32_t a, uint32_t b, uint32_t& fflags) { return min_max(a, b, true, fflags); }
+constexpr uint32_t min(uint32_t a, uint32_t b, uint32_t& fflags) {
+    return min_max(a, b, false, fflags);
+}
+constexpr uint32_t max(uint32_t a, uint32_t b, uint32_t& fflags) {
+    return min_max(a, b, true, fflags);
+}
 
 /// Numeric comparison key: like total_key but with -0 == +0.
-constexpr int64_t numeric_key(uint32_t a) { return is_zero(a) ? 0 : total_key(a); }
+constexpr int64_t numeric_key(uint32_t a) {
+    return is_zero(a) ? 0 : total_key(a);
+}
 
 /// feq.s is a quiet comparison: only signaling NaNs raise NV.
 constexpr uint32_t eq(uint32_t a, uint32_t b, uint32_t& fflags) {
@@ -89,4 +101,4 @@ constexpr uint32_t classify(uint32_t a) {
     return negative ? 1u << 1 : 1u << 6;
 }
 
-}  // namespace tpsim::isa::fpu
+} // namespace tpsim::isa::fpu

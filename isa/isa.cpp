@@ -1,8 +1,8 @@
 // The static instruction table (expanded from instructions.def) and small accessors.
 #include "isa.hpp"
 
-#include <iterator>
 #include <bit>
+#include <iterator>
 
 #include "hart.hpp"
 
@@ -10,7 +10,7 @@ namespace tpsim::isa {
 
 const InsnInfo& info(Op op) {
     static constexpr InsnInfo kTable[] = {
-#define TPSIM_INSN(name, mnemonic, match, mask, format, fu, operands, ...) \
+#define TPSIM_INSN(name, mnemonic, match, mask, format, fu, operands, ...)                         \
     {mnemonic, match, mask, format, fu, operand_info(operands)},
 #include "instructions.def"
 #undef TPSIM_INSN
@@ -22,24 +22,40 @@ const InsnInfo& info(Op op) {
 
 std::string_view to_string(FuClass fu) {
     switch (fu) {
-        case FuClass::IntAlu: return "int_alu";
-        case FuClass::IntMul: return "int_mul";
-        case FuClass::IntDiv: return "int_div";
-        case FuClass::FpAdd: return "fp_add";
-        case FuClass::FpMul: return "fp_mul";
-        case FuClass::FpDiv: return "fp_div";
-        case FuClass::FpSqrt: return "fp_sqrt";
-        case FuClass::FpMisc: return "fp_misc";
-        case FuClass::Branch: return "branch";
-        case FuClass::Load: return "load";
-        case FuClass::Store: return "store";
-        case FuClass::Atomic: return "atomic";
-        case FuClass::System: return "system";
-        case FuClass::Count: break;
+    case FuClass::IntAlu:
+        return "int_alu";
+    case FuClass::IntMul:
+        return "int_mul";
+    case FuClass::IntDiv:
+        return "int_div";
+    case FuClass::FpAdd:
+        return "fp_add";
+    case FuClass::FpMul:
+        return "fp_mul";
+    case FuClass::FpDiv:
+        return "fp_div";
+    case FuClass::FpSqrt:
+        return "fp_sqrt";
+    case FuClass::FpMisc:
+        return "fp_misc";
+    case FuClass::Branch:
+        return "branch";
+    case FuClass::Load:
+        return "load";
+    case FuClass::Store:
+        return "store";
+    case FuClass::Atomic:
+        return "atomic";
+    case FuClass::System:
+        return "system";
+    case FuClass::Count:
+        break;
     }
     return "?";
 }
 
-float Hart::f(unsigned i) const { return std::bit_cast<float>(reg[kFpBase + i]); }
+float Hart::f(unsigned i) const {
+    return std::bit_cast<float>(reg[kFpBase + i]);
+}
 
-}  // namespace tpsim::isa
+} // namespace tpsim::isa

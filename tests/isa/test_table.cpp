@@ -28,7 +28,7 @@ TEST_CASE("every table entry is self-consistent", "[isa][table]") {
         const InsnInfo& insn = info(Op(i));
         INFO(insn.mnemonic);
         CHECK((insn.match & ~insn.mask) == 0);
-        CHECK((insn.mask & 0x7f) == 0x7f);  // the major opcode is always fixed
+        CHECK((insn.mask & 0x7f) == 0x7f); // the major opcode is always fixed
         CHECK(insn.fu != FuClass::Count);
     }
 }
@@ -44,7 +44,7 @@ TEST_CASE("every instruction decodes back to itself from random operand fields",
             const Decoded d = decode(word);
             const uint32_t rm = word >> 12 & 7;
             if (insn.operands.rounding_mode && (rm == 5 || rm == 6)) {
-                CHECK(d.op == Op::Illegal);  // reserved rounding modes
+                CHECK(d.op == Op::Illegal); // reserved rounding modes
                 continue;
             }
             REQUIRE(d.op == op);
@@ -63,16 +63,16 @@ TEST_CASE("every instruction decodes back to itself from random operand fields",
 }
 
 TEST_CASE("decoder rejects what is not RV32IMF + tpsim", "[isa][decode]") {
-    CHECK(decode(0x0000'0000).op == Op::Illegal);  // all-zero word: defined illegal
-    CHECK(decode(0xffff'ffff).op == Op::Illegal);  // all-ones word: defined illegal
-    CHECK(decode(0x0200'1013).op == Op::Illegal);  // slli with shamt[5]=1 is RV64 only
-    CHECK(decode(0x0000'3003).op == Op::Illegal);  // ld (RV64)
-    CHECK(decode(0x0000'3007).op == Op::Illegal);  // fld (D extension)
-    CHECK(decode(0x0200'0053).op == Op::Illegal);  // fadd.d
-    CHECK(decode(0x1000'202f).op == Op::Illegal);  // lr.w (A extension)
-    CHECK(decode(0x0000'0001).op == Op::Illegal);  // compressed quadrant
-    CHECK(decode(0x0000'800b).op == Op::Illegal);  // custom-0 with rs1 = x1
-    CHECK(decode(0x1000'000b).op == Op::Illegal);  // custom-0 with imm = 256
+    CHECK(decode(0x0000'0000).op == Op::Illegal); // all-zero word: defined illegal
+    CHECK(decode(0xffff'ffff).op == Op::Illegal); // all-ones word: defined illegal
+    CHECK(decode(0x0200'1013).op == Op::Illegal); // slli with shamt[5]=1 is RV64 only
+    CHECK(decode(0x0000'3003).op == Op::Illegal); // ld (RV64)
+    CHECK(decode(0x0000'3007).op == Op::Illegal); // fld (D extension)
+    CHECK(decode(0x0200'0053).op == Op::Illegal); // fadd.d
+    CHECK(decode(0x1000'202f).op == Op::Illegal); // lr.w (A extension)
+    CHECK(decode(0x0000'0001).op == Op::Illegal); // compressed quadrant
+    CHECK(decode(0x0000'800b).op == Op::Illegal); // custom-0 with rs1 = x1
+    CHECK(decode(0x1000'000b).op == Op::Illegal); // custom-0 with imm = 256
     // fadd.s with rm = 5 and 6 is reserved; 7 (dynamic) is legal.
     CHECK(decode(encode(Op::fadd_s, 1, 2, 3, 0, 5)).op == Op::Illegal);
     CHECK(decode(encode(Op::fadd_s, 1, 2, 3, 0, 6)).op == Op::Illegal);
@@ -104,18 +104,20 @@ std::vector<std::string> read_lines(const char* path) {
     std::ifstream in(path);
     REQUIRE(in);
     std::vector<std::string> lines;
-    for (std::string line; std::getline(in, line);) lines.push_back(line);
+    for (std::string line; std::getline(in, line);)
+        lines.push_back(line);
     return lines;
 }
 
 std::string collapse_whitespace(const std::string& s) {
     std::istringstream in(s);
     std::string word, out;
-    while (in >> word) out += (out.empty() ? "" : " ") + word;
+    while (in >> word)
+        out += (out.empty() ? "" : " ") + word;
     return out;
 }
 
-}  // namespace
+} // namespace
 
 TEST_CASE("decode and disassembly match LLVM on every instruction", "[isa][decode][disasm][llvm]") {
     // Source mnemonics, in order, one instruction per non-comment line.
@@ -125,7 +127,8 @@ TEST_CASE("decode and disassembly match LLVM on every instruction", "[isa][decod
         mnemonics.push_back(line.substr(0, line.find(' ')));
     }
     // llvm-objdump lines: "  addr: b0 b1 b2 b3 \tmnemonic\toperands [<symbol+off>]".
-    const std::regex row(R"(^\s*([0-9a-f]+):\s+([0-9a-f]{2}) ([0-9a-f]{2}) ([0-9a-f]{2}) ([0-9a-f]{2})\s+([^<]*))");
+    const std::regex row(
+        R"(^\s*([0-9a-f]+):\s+([0-9a-f]{2}) ([0-9a-f]{2}) ([0-9a-f]{2}) ([0-9a-f]{2})\s+([^<]*))");
     size_t index = 0;
     std::vector<bool> seen(kNumInsns);
     for (const std::string& line : read_lines(TPSIM_ALL_INSNS_DIS)) {
@@ -134,7 +137,8 @@ TEST_CASE("decode and disassembly match LLVM on every instruction", "[isa][decod
         REQUIRE(index < mnemonics.size());
         const uint32_t pc = uint32_t(std::stoul(m[1], nullptr, 16));
         uint32_t word = 0;
-        for (int b = 0; b < 4; ++b) word |= uint32_t(std::stoul(m[2 + b], nullptr, 16)) << (8 * b);
+        for (int b = 0; b < 4; ++b)
+            word |= uint32_t(std::stoul(m[2 + b], nullptr, 16)) << (8 * b);
         const Decoded d = decode(word);
         INFO(line);
         CHECK(info(d.op).mnemonic == mnemonics[index]);
