@@ -1,0 +1,172 @@
+#include "memory_image.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "kernel/memory_map.hpp"
+#include "sim/core/error.hpp"
+
+namespace tpsim::image {
+namespace layout = trax::layout;
+
+namespace {
+
+void put(float (&out)[3], glm::vec3 v) {
+    out[0] = v.x;
+    out[1] = v.y;
+    out[2] = v.z;
+}
+
+layout::Camera compile_camera(const scene::Camera& c, uint32_t width, uint32_t height) {
+    const glm::vec3 forward = glm::normalize(c.look_at - c.eye);
+    const glm::vec3 right = glm::normalize(glm::cross(forward, c.up));
+    const glm::vec3 up = glm::cross(right, forward);
+    const float half_height = std::tan(glm::radians(c.vertical_fov_degrees) * 0.5f);
+    const float half_width = half_height * float(width) / float(height);
+    layout::Camera out{};
+    put(out.eye, c.eye);
+    put(out.corner, forward - right * half_width + up * half_height);
+    put(out.right, right * (2.f * half_width));
+    put(out.down, up * (-2.f * half_height));
+    return out;
+}
+
+/// Copies a record into the image at a word address.
+template <class Record>
+void write(std::vector<uint32_t>& words, int32_t addr, const Record& record) {
+    static_assert(sizeof(Record) % 4 == 0);
+    std::memcpy(words.data() + addr, &record, sizeof(Record));
+}
+
+/// Re-lays the builder's depth-first nodes (left child next, right child anywhere) so that the
+/// two children of every interior node are adjacent, as layout::BvhNode requires; breadth-first
+/// order does that and keeps the top levels of the tree together in a few cache lines.
+std::vector<layout::BvhNode> compile_bvh(const scene::Bvh& bvh) {
+    std::vector<layout::BvhNode> out;
+    out.reserve(bvh.nodes.size());
+    std::vector<uint32_t> queue{0};  // builder node indices, in output order
+    queue.reserve(bvh.nodes.size());
+    for (size_t i = 0; i < queue.size(); ++i) {
+        const scene::BvhNode& n = bvh.nodes[queue[i]];
+        layout::BvhNode node{};
+        put(node.bounds_min, n.bounds.lo);
+        put(node.bounds_max, n.bounds.hi);
+        if (n.is_leaf()) {
+            node.first = int32_t(n.first_triangle);
+            node.count = int32_t(n.triangle_count);
+        } else {
+            node.first = int32_t(queue.size());
+            node.count = 0;
+            queue.push_back(queue[i] + 1);
+            queue.push_back(n.right_child);
+        }
+        out.push_back(node);
+    }
+    return out;
+}
+
+}  // namespace
+
+MemoryImage build_memory_image(const scene::Scene& scene, const scene::Bvh* bvh) {
+    if (scene.width == 0 || scene.height == 0)
+        throw Error("scene has an empty image (width or height is 0)");
+    if (scene.triangles.empty()) throw Error("scene has no triangles");
+
+    layout::SceneHeader h{};
+    h.magic = layout::kMagic;
+    h.version = layout::kVersion;
+    h.image_width = int32_t(scene.width);
+    h.image_height = int32_t(scene.height);
+    h.samples_per_pixel = int32_t(scene.samples_per_pixel);
+    // Leave out what the scene does not need: no lights means no shadow rays and no falloff.
+    if (!scene.lights.empty()) {
+        if (scene.shadows) h.flags |= layout::kFeatureShadows;
+        if (scene.light_falloff) h.flags |= layout::kFeatureLightFalloff;
+    }
+    put(h.ambient, scene.ambient);
+    put(h.background, scene.background);
+
+    const auto checked_count = [](size_t n, const char* what) {
+        if (n > size_t(std::numeric_limits<int32_t>::max() / 16))
+            throw Error(fmt::format("scene has too many {} ({}) for the 32-bit memory image", what, n));
+        return int32_t(n);
+    };
+    std::vector<layout::BvhNode> nodes;
+    if (bvh != nullptr) nodes = compile_bvh(*bvh);
+    h.lights.count = checked_count(scene.lights.size(), "lights");
+    h.materials.count = checked_count(scene.materials.size(), "materials");
+    h.triangles.count = checked_count(scene.triangles.size(), "triangles");
+    h.bvh_nodes.count = checked_count(nodes.size(), "BVH nodes");
+    const uint64_t pixels = uint64_t(scene.width) * scene.height;
+    if (pixels > uint64_t(std::numeric_limits<int32_t>::max() / 16))
+        throw Error(fmt::format("image {}x{} is too large for the 32-bit memory image",
+                                scene.width, scene.height));
+    const uint64_t estimate = uint64_t(h.triangles.count) * layout::kTriangleWords +
+                              uint64_t(h.bvh_nodes.count) * layout::kBvhNodeWords +
+                              pixels * layout::kPixelWords + 4096;
+    // Global memory spans kGlobalBase..kLocalTop - kStackGuard in the guest address space.
+    constexpr uint64_t kMaxWords =
+        (trax::map::kLocalTop - trax::map::kStackGuard - trax::map::kGlobalBase) / 4;
+    if (estimate > kMaxWords)
+        throw Error(fmt::format("scene needs about {} MiB of global memory; the address map has "
+                                "room for {} MiB (reduce the image size or the mesh)",
+                                estimate * 4 >> 20, kMaxWords * 4 >> 20));
+    layout::place_sections(h);
+
+    MemoryImage image;
+    image.words.assign(size_t(h.total_words), 0u);
+    write(image.words, 0, h);
+    write(image.words, h.camera.addr, compile_camera(scene.camera, scene.width, scene.height));
+    for (size_t i = 0; i < scene.lights.size(); ++i) {
+        layout::PointLight light{};
+        put(light.position, scene.lights[i].position);
+        put(light.color, scene.lights[i].color);
+        write(image.words, h.lights.addr + int32_t(i) * layout::kPointLightWords, light);
+    }
+    for (size_t i = 0; i < scene.materials.size(); ++i) {
+        layout::Material material{};
+        put(material.diffuse, scene.materials[i].diffuse);
+        write(image.words, h.materials.addr + int32_t(i) * layout::kMaterialWords, material);
+    }
+    for (size_t i = 0; i < scene.triangles.size(); ++i) {
+        // With a BVH, leaves index contiguous runs of triangles: store them in leaf order.
+        const scene::Triangle& t = scene.triangles[bvh ? bvh->triangle_order[i] : i];
+        if (t.material >= scene.materials.size())
+            throw Error(fmt::format("triangle {} uses material {} but the scene has {}", i,
+                                    t.material, scene.materials.size()));
+        layout::Triangle tri{};
+        put(tri.v0, t.v0);
+        put(tri.v1, t.v1);
+        put(tri.v2, t.v2);
+        tri.material = int32_t(t.material);
+        write(image.words, h.triangles.addr + int32_t(i) * layout::kTriangleWords, tri);
+    }
+    for (size_t i = 0; i < nodes.size(); ++i)
+        write(image.words, h.bvh_nodes.addr + int32_t(i) * layout::kBvhNodeWords, nodes[i]);
+
+    const auto section = [](const char* name, const layout::SectionRef& ref, int32_t words) {
+        return SectionSize{name, uint32_t(ref.count), uint64_t(ref.count) * uint64_t(words) * 4};
+    };
+    image.header = h;
+    image.sections = {
+        {"header", 1, sizeof(layout::SceneHeader)},
+        section("camera", h.camera, layout::kCameraWords),
+        section("lights", h.lights, layout::kPointLightWords),
+        section("materials", h.materials, layout::kMaterialWords),
+        section("triangles", h.triangles, layout::kTriangleWords),
+        section("bvh_nodes", h.bvh_nodes, layout::kBvhNodeWords),
+        section("framebuffer", h.framebuffer, layout::kPixelWords),
+    };
+    return image;
+}
+
+std::vector<float> read_framebuffer(const layout::SceneHeader& header, const uint32_t* words) {
+    std::vector<float> rgb(size_t(header.framebuffer.count) * layout::kPixelWords);
+    std::memcpy(rgb.data(), words + header.framebuffer.addr, rgb.size() * sizeof(float));
+    return rgb;
+}
+
+}  // namespace tpsim::image
