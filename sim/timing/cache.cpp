@@ -140,18 +140,6 @@ ICacheBanks::ICacheBanks(const ICacheConfig& config, uint32_t num_threads)
       banks_(size_t{(num_threads + config.threads_per_icache - 1) / config.threads_per_icache} *
              config.banks) {}
 
-bool ICacheBanks::fetch(uint64_t now, uint32_t tp, uint32_t pc) {
-    const uint32_t icache = tp / threads_per_icache_;
-    Bank& bank = banks_[size_t{icache} * banks_per_icache_ + (pc / 4) % banks_per_icache_];
-    if (bank.cycle == now && bank.pc != pc) {
-        ++counters_.conflicts;
-        return false;
-    }
-    bank = {now, pc};
-    ++counters_.fetches;
-    return true;
-}
-
 void ICacheBanks::register_stats(stats::Registry& r, std::string_view prefix) const {
     r.add_counter(fmt::format("{}/fetches", prefix), counters_.fetches, "instructions fetched");
     r.add_counter(fmt::format("{}/conflicts", prefix), counters_.conflicts,

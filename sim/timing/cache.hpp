@@ -106,7 +106,17 @@ public:
 
     /// Thread `tp` fetches `pc` in cycle `now`; false = conflict, try again next cycle.
     /// Within a cycle, earlier callers win: the caller decides the (rotating) order.
-    bool fetch(uint64_t now, uint32_t tp, uint32_t pc);
+    bool fetch(uint64_t now, uint32_t tp, uint32_t pc) {
+        Bank& bank = banks_[size_t{tp / threads_per_icache_} * banks_per_icache_ +
+                            (pc / 4) % banks_per_icache_];
+        if (bank.cycle == now && bank.pc != pc) {
+            ++counters_.conflicts;
+            return false;
+        }
+        bank = {now, pc};
+        ++counters_.fetches;
+        return true;
+    }
 
     const Counters& counters() const { return counters_; }
     void register_stats(stats::Registry& registry, std::string_view prefix) const;

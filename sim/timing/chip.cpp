@@ -25,6 +25,8 @@ struct Chip::Tm {
         std::array<uint64_t, isa::kNumRegs> reg_ready{};  // cycle each register becomes readable
         std::array<Pool, isa::kNumRegs> reg_producer{};   // pool that will write it
         StepInfo pending;            // fetched, not yet issued
+        isa::FuClass pending_class{};
+        Pool pending_pool{};
         bool has_pending = false;
         bool done = false;
         uint64_t fetch_at = 0;       // earliest cycle of the next fetch (branch bubbles)
@@ -68,6 +70,7 @@ Chip::Chip(const ChipConfig& config, InstructionSource& source)
       dram_(config.dram, config.l2.line_bytes),
       global_registers_(config.global_registers) {
     validate(config_);
+    for (size_t op = 0; op < class_of_.size(); ++op) class_of_[op] = isa::info(isa::Op(op)).fu;
     for (uint32_t t = 0; t < config.chip.num_tms; ++t) {
         tms_.push_back(std::make_unique<Tm>(config, t));
         tms_.back()->running = config.chip.tps_per_tm;
@@ -191,6 +194,8 @@ void Chip::tick_tm(Tm& tm, uint64_t now) {
                 continue;
             }
             tp.pending = source_.step(thread);
+            tp.pending_class = class_of_[size_t(tp.pending.insn->op)];
+            tp.pending_pool = pool_of(tp.pending_class);
             tp.has_pending = true;
         }
         const isa::Decoded& d = *tp.pending.insn;
@@ -206,7 +211,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now) {
             ++tm.counters.operand_stalls[size_t(blocking)];
             continue;
         }
-        const Pool pool = pool_of(isa::info(d.op).fu);
+        const Pool pool = tp.pending_pool;
         if (pool == Pool::LoadStore && tp.mem_waiting && !is_local(tp.pending.mem_address)) {
             ++tm.counters.stalls[size_t(Stall::MemoryPort)];
             continue;
@@ -223,7 +228,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now) {
             Tm::Tp& tp = tm.tps[i];
             const StepInfo& s = tp.pending;
             const isa::Decoded& d = *s.insn;
-            const isa::FuClass fu = isa::info(d.op).fu;
+            const isa::FuClass fu = tp.pending_class;
             ++tm.counters.instructions;
             ++tm.counters.per_class[size_t(fu)];
             ++progress_;

@@ -57,7 +57,10 @@ bool Dram::enqueue(uint64_t now, const MemRequest& request) {
         return false;
     }
     const DramLocation where = locate(request.addr);
-    channels_[where.channel].queue.push_back({request, where, now});
+    Channel& ch = channels_[where.channel];
+    ch.queue.push_back({request, where, now});
+    Bank& bank = ch.banks[where.bank];
+    bank.queued_hits += bank.open_row == where.row;
     return true;
 }
 
@@ -79,15 +82,10 @@ void Dram::issue(Channel& ch, Bank& bank, DramCommand cmd, uint64_t now) {
     }
 }
 
-bool Dram::row_wanted(const Channel& ch, uint32_t bank, uint32_t row) const {
-    return std::any_of(ch.queue.begin(), ch.queue.end(), [&](const Pending& p) {
-        return p.where.bank == bank && p.where.row == row;
-    });
-}
-
 void Dram::serve(Channel& ch, size_t index, uint64_t now) {
     const Pending p = ch.queue[index];
     ch.queue.erase(ch.queue.begin() + static_cast<std::ptrdiff_t>(index));
+    --ch.banks[p.where.bank].queued_hits;  // served requests always hit the open row
     if (p.precharged)
         ++counters_.row_conflicts;
     else if (p.activated)
@@ -128,15 +126,18 @@ void Dram::tick(uint64_t now) {
                 if (!ready(ch, bank, Activate, now)) continue;
                 issue(ch, bank, Activate, now);
                 bank.open_row = p.where.row;
+                bank.queued_hits = static_cast<uint32_t>(
+                    std::count_if(ch.queue.begin(), ch.queue.end(), [&](const Pending& q) {
+                        return q.where.bank == p.where.bank && q.where.row == p.where.row;
+                    }));
                 p.activated = true;
                 ++counters_.activates;
                 issued = true;
-            } else if (bank.open_row != p.where.row &&
-                       !row_wanted(ch, p.where.bank, bank.open_row)) {
+            } else if (bank.open_row != p.where.row && bank.queued_hits == 0) {
                 // Close a row only when no queued request still hits it.
                 if (!ready(ch, bank, Precharge, now)) continue;
                 issue(ch, bank, Precharge, now);
-                bank.open_row = kClosed;
+                bank.open_row = kClosed;  // queued_hits is already 0
                 p.precharged = true;
                 ++counters_.precharges;
                 issued = true;

@@ -86,6 +86,7 @@ private:
     };
     struct Bank {
         uint32_t open_row = kClosed;
+        uint32_t queued_hits = 0;  // queued requests for open_row (kept current, not rescanned)
         std::array<uint64_t, kCommands> earliest{};
     };
     struct Channel {
@@ -105,7 +106,6 @@ private:
     bool ready(const Channel& ch, const Bank& bank, DramCommand cmd, uint64_t now) const;
     void issue(Channel& ch, Bank& bank, DramCommand cmd, uint64_t now);
     void serve(Channel& ch, size_t index, uint64_t now);
-    bool row_wanted(const Channel& ch, uint32_t bank, uint32_t row) const;
 
     DramConfig config_;
     uint32_t line_bytes_;

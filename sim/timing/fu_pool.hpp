@@ -16,7 +16,7 @@ namespace tpsim::timing {
 enum class Pool : uint8_t { IntAlu, IntMulDiv, FpAdd, FpMul, FpDivSqrt, FpMisc, Branch, LoadStore,
                             Atomic, Count };
 
-Pool pool_of(isa::FuClass fu);
+Pool pool_of(isa::FuClass fu);  // throws for FuClass::Count
 std::string_view to_string(Pool pool);
 const FuConfig& pool_config(const FuPoolsConfig& pools, Pool pool);
 
@@ -39,7 +39,7 @@ public:
     template <class OnGrant>
     void arbitrate(uint64_t now, OnGrant&& on_grant) {
         if (pending_.empty()) return;
-        order_by_priority();
+        if (pending_.size() > 1) order_by_priority();
         uint32_t last_granted = kNone;
         for (uint32_t id : pending_) {
             if (!try_start(now)) {
