@@ -1,25 +1,12 @@
-// The tpsim command: parses the command line and hands each subcommand to the libraries.
-// To add a subcommand, write an add_<name>_command() that registers its options and returns
-// the action to run, and list it in main().
-#include <cstdio>
-#include <functional>
+// `tpsim exec PROGRAM.elf`: runs a bare-metal RV32IMF program on one thread.
 #include <memory>
 #include <string>
 
-#include <CLI/CLI.hpp>
-#include <fmt/format.h>
-
+#include "commands.hpp"
 #include "sim/core/elf_loader.hpp"
-#include "sim/core/error.hpp"
 #include "sim/core/machine.hpp"
 
-namespace {
-
-/// A registered subcommand and what to do when the user chose it.
-struct Command {
-    CLI::App* parser;
-    std::function<int()> run;  ///< returns the process exit status
-};
+namespace tpsim::cli {
 
 /// `tpsim exec PROGRAM.elf`: one thread, exit code = the program's exit code.
 Command add_exec_command(CLI::App& app) {
@@ -48,19 +35,4 @@ Command add_exec_command(CLI::App& app) {
     }};
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-    CLI::App app{"tpsim: a cycle-counting simulator of TRaX ray-tracing hardware"};
-    app.require_subcommand(1);
-    const Command commands[] = {add_exec_command(app)};
-    CLI11_PARSE(app, argc, argv);
-    try {
-        for (const Command& command : commands)
-            if (command.parser->parsed()) return command.run();
-    } catch (const tpsim::Error& e) {
-        fmt::print(stderr, "tpsim: {}\n", e.what());
-        return 2;
-    }
-    return 0;
-}
+}  // namespace tpsim::cli

@@ -1,0 +1,24 @@
+// The tpsim command: parses the command line and hands the chosen subcommand to the libraries.
+// To add a subcommand, write an add_<name>_command() (commands.hpp) and list it below.
+#include <exception>
+
+#include <fmt/format.h>
+
+#include "commands.hpp"
+
+int main(int argc, char** argv) {
+    CLI::App app{"tpsim: a cycle-counting simulator of TRaX ray-tracing hardware"};
+    app.require_subcommand(1);
+    const tpsim::cli::Command commands[] = {tpsim::cli::add_render_command(app),
+                                            tpsim::cli::add_exec_command(app)};
+    CLI11_PARSE(app, argc, argv);
+    try {
+        for (const tpsim::cli::Command& command : commands)
+            if (command.parser->parsed()) return command.run();
+    } catch (const std::exception& e) {
+        // Every tpsim error is one line saying what, where and how to fix it.
+        fmt::print(stderr, "tpsim: {}\n", e.what());
+        return 2;
+    }
+    return 0;
+}

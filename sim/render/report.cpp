@@ -1,0 +1,86 @@
+#include "report.hpp"
+
+#include <ostream>
+
+#include <fmt/format.h>
+#include <fmt/ostream.h>
+
+namespace tpsim::render {
+
+void register_stats(const RenderResult& r, stats::Registry& reg) {
+    const auto number = [&reg](std::string name, auto get, std::string description,
+                               std::string unit = "") {
+        reg.add_derived(std::move(name), [get] { return double(get()); }, std::move(description),
+                        std::move(unit));
+    };
+    number("scene/triangles", [&r] { return r.scene.triangles.size(); }, "triangles in the scene");
+    number("scene/lights", [&r] { return r.scene.lights.size(); }, "point lights");
+    number("scene/materials", [&r] { return r.scene.materials.size(); }, "materials used");
+    number("image/pixels", [&r] { return uint64_t(r.scene.width) * r.scene.height; },
+           "pixels rendered");
+    number("image/samples_per_pixel", [&r] { return r.scene.samples_per_pixel; },
+           "camera rays per pixel");
+
+    for (const image::SectionSize& s : r.image.sections)
+        number("memory/" + s.name + "_bytes", [&s] { return s.bytes; },
+               fmt::format("memory image: {} ({} records)", s.name, s.records), "B");
+    number("memory/total_bytes", [&r] { return r.image.bytes(); },
+           "memory image incl. alignment padding and framebuffer", "B");
+
+    if (r.bvh) {
+        const scene::BvhStats& b = *r.bvh;
+        number("bvh/nodes", [&b] { return b.nodes; }, "BVH nodes (interior + leaves)");
+        number("bvh/leaves", [&b] { return b.leaves; }, "BVH leaves");
+        number("bvh/max_depth", [&b] { return b.max_depth; }, "edges from the root to the deepest leaf");
+        number("bvh/sah_cost", [&b] { return b.sah_cost; },
+               "SAH cost (traversal 1, intersection 1, relative to the root's area)");
+        number("bvh/depth_limited_nodes", [&b] { return b.depth_limited_nodes; },
+               "nodes where the traversal-stack depth limit overrode the SAH");
+        number("host/bvh_seconds", [&r] { return r.bvh_seconds; }, "BVH build time", "s");
+    }
+
+    if (r.instructions.total > 0) {
+        reg.add_counter("instructions/total", r.instructions.total, "instructions executed");
+        for (size_t fu = 0; fu < r.instructions.per_fu.size(); ++fu)
+            if (r.instructions.per_fu[fu] != 0)
+                reg.add_counter(fmt::format("instructions/fu/{}", isa::to_string(isa::FuClass(fu))),
+                                r.instructions.per_fu[fu], "instructions of this FU class");
+        for (size_t op = 0; op < r.instructions.per_op.size(); ++op)
+            if (r.instructions.per_op[op] != 0)
+                reg.add_counter(fmt::format("instructions/op/{}", isa::info(isa::Op(op)).mnemonic),
+                                r.instructions.per_op[op], "instructions with this opcode");
+    }
+    number("host/load_seconds", [&r] { return r.load_seconds; }, "scene load and import time", "s");
+    number("host/run_seconds", [&r] { return r.run_seconds; }, "kernel run time on the host", "s");
+    if (r.instructions.total > 0)
+        number("host/simulated_instructions_per_second",
+               [&r] { return r.run_seconds > 0 ? double(r.instructions.total) / r.run_seconds : 0.0; },
+               "simulation speed", "instr/s");
+}
+
+void print_summary(const RenderOptions& options, const RenderResult& r, std::ostream& out) {
+    fmt::print(out, "scene    {} ({} triangles, {} lights, {} materials), {}x{} pixels, {} spp\n",
+               options.scene.string(), r.scene.triangles.size(), r.scene.lights.size(),
+               r.scene.materials.size(), r.scene.width, r.scene.height, r.scene.samples_per_pixel);
+    fmt::print(out, "kernel   {} on {} ({} TMs x {} TPs = {} threads)\n", options.kernel.string(),
+               options.engine == Engine::native ? "the native twin" : "the functional simulator",
+               options.chip.chip.num_tms, options.chip.chip.tps_per_tm, r.threads);
+    fmt::print(out, "memory   {:.1f} KiB:", double(r.image.bytes()) / 1024);
+    for (const image::SectionSize& s : r.image.sections)
+        if (s.records > 0) fmt::print(out, " {} {:.1f} KiB,", s.name, double(s.bytes) / 1024);
+    fmt::print(out, "\n");
+    if (r.bvh)
+        fmt::print(out, "bvh      {} nodes, {} leaves, depth {}, SAH cost {:.2f}, built in {:.3f} s{}\n",
+                   r.bvh->nodes, r.bvh->leaves, r.bvh->max_depth, r.bvh->sah_cost, r.bvh_seconds,
+                   r.bvh->depth_limited_nodes
+                       ? fmt::format(" (depth limit shaped {} nodes)", r.bvh->depth_limited_nodes)
+                       : "");
+    if (r.instructions.total > 0)
+        fmt::print(out, "run      {} instructions in {:.3f} s = {:.1f} M simulated instructions/s\n",
+                   r.instructions.total, r.run_seconds,
+                   double(r.instructions.total) / r.run_seconds / 1e6);
+    else
+        fmt::print(out, "run      {:.3f} s\n", r.run_seconds);
+}
+
+}  // namespace tpsim::render
