@@ -2,7 +2,10 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <deque>
+#include <fstream>
+#include <regex>
 #include <sstream>
 
 using namespace tpsim::timing;
@@ -221,4 +224,32 @@ std::string run_mixed() {
 TEST_CASE("identical inputs give identical statistics", "[chip][determinism]") {
     const std::string first = run_mixed();
     CHECK(first == run_mixed());
+}
+
+TEST_CASE("every registered key is documented in docs/statistics.md", "[chip][docs]") {
+    std::ifstream doc(std::string(TPSIM_DOCS_DIR) + "/statistics.md");
+    REQUIRE(doc);
+    // Backticked keys containing '/' become regexes: <placeholder> matches one segment.
+    std::vector<std::regex> documented;
+    const std::regex quoted("`([A-Za-z0-9_<>.-]+/[A-Za-z0-9_<>/.-]+)`");
+    for (std::string line; std::getline(doc, line);)
+        for (std::sregex_iterator m(line.begin(), line.end(), quoted), end; m != end; ++m)
+            documented.emplace_back(
+                std::regex_replace((*m)[1].str(), std::regex("<[^>]+>"), "[^/]+"));
+    REQUIRE(documented.size() > 20);
+    ChipConfig c;
+    c.chip.num_tms = 2;
+    c.chip.tps_per_tm = 2;
+    c.chip.tms_per_l2 = 1;
+    Script s(4);
+    s.finish();
+    Chip chip(c, s);
+    stats::Registry r;
+    chip.register_stats(r);
+    for (const stats::Entry& e : r.entries()) {
+        const bool found = std::any_of(documented.begin(), documented.end(),
+                                       [&](const std::regex& re) { return std::regex_match(e.name, re); });
+        INFO(e.name);
+        CHECK(found);
+    }
 }
