@@ -1,6 +1,7 @@
 #include "machine.hpp"
 
 #include <algorithm>
+#include <bit>
 
 #include <fmt/format.h>
 
@@ -85,6 +86,8 @@ public:
         if (number == kExitSyscall) {
             thread_.state = ThreadState::Exited;
             thread_.exit_code = int32_t(h.reg[kA0]);
+            thread_.exit_pc = h.pc;
+            h.pc = kParkedPc;
             if constexpr (kRecord) exited_ = true;
             return;
         }
@@ -208,19 +211,30 @@ void Machine::run_quantum(uint32_t id, uint64_t budget, StepRecord* record) {
     ThreadEnv<kRecord> env(*this, id);
     uint64_t* per_op = counters_.per_op.data();
     const isa::Decoded* decoded = decoded_.data();
+    // Locals, not members: stores through the hart's registers could alias members, and the
+    // compiler would reload them every instruction.
+    const uint32_t text_base = text_base_;
+    const uint32_t text_words = text_bytes_ / 4;
     uint64_t done = 0;
     uint32_t pc = h.pc;
     try {
-        for (; done < budget && t.state == ThreadState::Running; ++done) {
+        for (; done < budget; ++done) {
             pc = h.pc;
-            const uint32_t offset = pc - text_base_;
-            if (offset >= text_bytes_ || offset % 4 != 0) fetch_fault(id, pc);
-            const isa::Decoded& d = decoded[offset / 4];
+            // One compare checks range and alignment: rotating moves misaligned low bits to the
+            // top. An exited thread's pc is parked at kParkedPc, so it fails here too and the
+            // loop needs no per-instruction exit test.
+            const uint32_t index = std::rotr(pc - text_base, 2);
+            if (index >= text_words) [[unlikely]] {
+                if (t.state != ThreadState::Running) break;
+                fetch_fault(id, pc);
+            }
+            const isa::Decoded& d = decoded[index];
             ++per_op[size_t(d.op)];
             isa::execute(d, h, env);
             if constexpr (kRecord) {
                 const AccessRecorder a = env.access();
-                *record = {pc, &d, a.address, a.bytes, a.store, h.pc != pc + 4, env.exited()};
+                const bool exited = env.exited();
+                *record = {pc, &d, a.address, a.bytes, a.store, !exited && h.pc != pc + 4, exited};
             }
         }
     } catch (const GuestFault& f) {

@@ -32,10 +32,14 @@ struct MachineConfig {
 
 enum class ThreadState : uint8_t { Running, Exited, Faulted };
 
+/// Where an exited thread's pc is parked: below kCodeBase, so never fetchable.
+constexpr uint32_t kParkedPc = 0;
+
 struct Thread {
     isa::Hart hart;
     ThreadState state = ThreadState::Running;
     int32_t exit_code = 0;   ///< a0 of the exit ecall
+    uint32_t exit_pc = 0;    ///< address of the exit ecall (hart.pc is parked at kParkedPc)
     /// Instructions executed, including the exit ecall and trapping ones (which instret does
     /// not count); checked against max_instructions.
     uint64_t executed = 0;

@@ -61,6 +61,7 @@ TEST_CASE("the exit ecall ends the thread with a0", "[sim][machine]") {
     Machine m = machine_for("exit_code");
     m.run();
     CHECK(m.thread(0).exit_code == 42);
+    CHECK(m.thread(0).exit_pc == m.program().entry + 8);
     // li a0; li a7; ecall
     CHECK(m.counters().instructions == 3);
     CHECK(m.counters().per_op[size_t(isa::Op::ecall)] == 1);
@@ -176,6 +177,10 @@ TEST_CASE("step() reports each instruction's pc, memory access and control flow"
     REQUIRE(trace.size() > 10);
     CHECK(trace.front().pc == entry);
     CHECK(trace.back().exited);
+    CHECK_FALSE(trace.back().taken);
+    const auto taken = std::count_if(trace.begin(), trace.end(),
+                                     [](const StepRecord& r) { return r.taken; });
+    CHECK(taken == 0);  // loadstore.S is straight-line code: CHECK's bne never branches
     CHECK(trace.back().insn->op == isa::Op::ecall);
     // The first load of the program is `lw t1, 0(t0)` of the .data word.
     const auto first_load = std::find_if(trace.begin(), trace.end(), [](const StepRecord& r) {
