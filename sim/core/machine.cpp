@@ -177,9 +177,13 @@ void Machine::fault(uint32_t id, uint32_t pc, const GuestFault& what) {
     std::string where = program_.describe_pc(pc);
     if (auto source = program_.source_at(pc))
         where += fmt::format("{}{}:{}", where.empty() ? "" : ", ", source->file, source->line);
+    // Name the instruction that did it, unless there is none: no code there, an undecodable
+    // word (the detail shows it), or a limit that stopped the thread before this instruction.
     const Segment* segment = program_.segment_at(pc);
-    const std::string instruction =
-        segment && segment->executable ? isa::disassemble(memory_.code_word(pc), pc) + " " : "";
+    const uint32_t word = memory_.code_word(pc);
+    const bool show = segment && segment->executable && isa::decode(word).op != isa::Op::Illegal &&
+                      what.kind != FaultKind::InstructionLimit;
+    const std::string instruction = show ? isa::disassemble(word, pc) + " " : "";
     throw Fault(what.kind, id, pc,
                 fmt::format("{} in thread {} at pc {:#010x}{}: {}{}; {}", to_string(what.kind), id,
                             pc, where.empty() ? "" : " (" + where + ")", instruction, what.detail,
@@ -200,7 +204,8 @@ void Machine::fetch_fault(uint32_t id, uint32_t pc) {
 void Machine::limit_fault(uint32_t id) {
     fault(id, threads_[id].hart.pc,
           {FaultKind::InstructionLimit,
-           fmt::format("instruction limit {} reached without exiting", config_.max_instructions),
+           fmt::format("the thread ran {} instructions (the limit) without exiting",
+                       config_.max_instructions),
            "raise it with --max-instructions, or look for an endless loop"});
 }
 

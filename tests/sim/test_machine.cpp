@@ -113,7 +113,7 @@ TEST_CASE("faults name kind, thread, pc, function, instruction and a fix", "[sim
         {"fault_unmapped_load", 8, "unmapped access", "reads 4 bytes at 0x40000000"},
         {"fault_misaligned_load", 12, "misaligned access", "not 4-byte aligned"},
         {"fault_write_code", 12, "write to read-only memory", "sw zero, 0(t0) writes 4 bytes"},
-        {"fault_illegal", 4, "illegal instruction", "word 0x00000000"},
+        {"fault_illegal", 4, "illegal instruction", "): word 0x00000000 is not"},
         {"fault_ebreak", 4, "breakpoint", "ebreak"},
         {"fault_bad_ecall", 8, "unsupported ecall", "a7=64"},
     };
@@ -155,7 +155,7 @@ TEST_CASE("a runaway thread stops at the instruction limit", "[sim][machine]") {
     const std::string message = fault_message(m);
     CHECK_THAT(message, Catch::StartsWith("instruction limit reached in thread 0 at pc 0x"));
     CHECK_THAT(message, Catch::Contains("(victim"));
-    CHECK_THAT(message, Catch::Contains("instruction limit 1000") &&
+    CHECK_THAT(message, Catch::Contains("): the thread ran 1000 instructions (the limit)") &&
                             Catch::Contains("--max-instructions"));
     CHECK(m.thread(0).executed == 1000);
 }
