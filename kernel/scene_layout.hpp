@@ -14,11 +14,15 @@ namespace trax::layout {
 /// "TPSC" little-endian: lets the loader and the twin reject a memory image that is not a scene.
 constexpr uint32_t kMagic = 0x4353'5054u;
 /// Bumped whenever a struct below changes shape.
-constexpr uint32_t kVersion = 1;
+constexpr uint32_t kVersion = 2;
 
 /// Sections start on 16-word (64-byte, one cache line) boundaries so no record of one section
 /// shares a line with another section.
 constexpr int32_t kSectionAlignWords = 16;
+
+/// Name of the marker symbol a kernel's ELF defines (TRAX_USES_BVH in trax.hpp) when it
+/// traverses the BVH: the host builds a BVH and lays it out only for such kernels.
+constexpr const char* kUsesBvhSymbol = "trax_uses_bvh";
 
 /// Feature flags in SceneHeader::flags: rendering choices the scene file makes.
 enum Feature : uint32_t {
@@ -73,6 +77,10 @@ struct BvhNode {
     int32_t count;
 };
 constexpr int32_t kMaxLeafTriangles = 8;
+/// Entries in the kernels' BVH traversal stack (kernel/rt.hpp). They keep the current node in a
+/// register and push only the far child, so a BVH whose deepest leaf is at depth <= this never
+/// overflows: the host builds with scene::BvhConfig::traversal_stack_entries set to it.
+constexpr int32_t kTraversalStackEntries = 32;
 
 /// The first words of global memory.
 struct SceneHeader {
@@ -91,6 +99,51 @@ struct SceneHeader {
     SectionRef triangles;
     SectionRef bvh_nodes;  ///< count 0 when the scene has no BVH
     SectionRef framebuffer;  ///< count = width * height pixels, 3 floats (linear RGB) each, row 0 = top
+    SectionRef thread_stats;  ///< one ThreadStats per hardware thread, written by the kernel
+    SectionRef rays;          ///< ray_query input batch (count 0 for renders)
+    SectionRef ray_results;   ///< ray_query output, one RayResult per ray
+};
+
+/// Traversal statistics of one hardware thread. The kernel counts in registers and writes its
+/// record once, before returning; the host sums the records. 64-bit counts are split in two
+/// words (lo, hi) so every field stays one 32-bit word.
+struct ThreadStats {
+    uint32_t primary_rays;      ///< closest-hit rays (camera rays, ray_query closest queries)
+    uint32_t shadow_rays;       ///< any-hit rays
+    uint32_t nodes_visited_lo;  ///< BVH node boxes tested (root included), summed over rays
+    uint32_t nodes_visited_hi;
+    uint32_t triangles_tested_lo;  ///< ray/triangle tests, summed over rays
+    uint32_t triangles_tested_hi;
+    uint32_t max_stack_depth;   ///< most traversal-stack entries in use at once
+    uint32_t stack_overflows;   ///< pushes refused because the stack was full (must stay 0)
+};
+
+/// Query modes of a Ray (bits).
+enum RayMode : int32_t {
+    kRayClosestHit = 0,
+    kRayAnyHit = 1,  ///< stop at the first hit, as a shadow ray does
+    /// The origin lies on triangle Ray::surface_triangle: offset it off that triangle's plane,
+    /// to the side the direction points to, as shading does for shadow rays.
+    kRayFromSurface = 2,
+};
+
+/// One query of the ray_query kernel: the segment origin + t * direction, 0 < t < t_max.
+struct Ray {
+    float origin[3];
+    float direction[3];
+    float t_max;
+    int32_t mode;              ///< RayMode bits
+    int32_t surface_triangle;  ///< kRayFromSurface: triangle index in the image (leaf order)
+};
+
+/// What ray_query writes for one Ray.
+struct RayResult {
+    int32_t triangle;  ///< image triangle index of the hit, or -1
+    float t;           ///< hit distance in units of the direction; t_max when nothing was hit
+    uint32_t nodes_visited;
+    uint32_t triangles_tested;
+    uint32_t max_stack_depth;
+    uint32_t stack_overflows;
 };
 
 /// Size of each record in words, the stride a kernel uses to step through a section.
@@ -100,6 +153,9 @@ constexpr int32_t kMaterialWords = sizeof(Material) / 4;
 constexpr int32_t kTriangleWords = sizeof(Triangle) / 4;
 constexpr int32_t kBvhNodeWords = sizeof(BvhNode) / 4;
 constexpr int32_t kPixelWords = 3;
+constexpr int32_t kThreadStatsWords = sizeof(ThreadStats) / 4;
+constexpr int32_t kRayWords = sizeof(Ray) / 4;
+constexpr int32_t kRayResultWords = sizeof(RayResult) / 4;
 constexpr int32_t kHeaderWords = sizeof(SceneHeader) / 4;
 
 /// Word offsets of header fields, for loadi(0, kHeader...) in kernels.
@@ -119,6 +175,9 @@ enum HeaderWord : int32_t {
     kHeaderTriangles = 19,
     kHeaderBvhNodes = 21,
     kHeaderFramebuffer = 23,
+    kHeaderThreadStats = 25,
+    kHeaderRays = 27,
+    kHeaderRayResults = 29,
 };
 
 /// Word offsets of record fields, for loadf(record_addr, kTri...) in kernels.
@@ -128,6 +187,11 @@ enum RecordWord : int32_t {
     kMaterialDiffuse = 0,
     kTriangleV0 = 0, kTriangleV1 = 3, kTriangleV2 = 6, kTriangleMaterial = 9,
     kNodeMin = 0, kNodeMax = 3, kNodeFirst = 6, kNodeCount = 7,
+    kStatsPrimaryRays = 0, kStatsShadowRays = 1, kStatsNodesVisited = 2,
+    kStatsTrianglesTested = 4, kStatsMaxStackDepth = 6, kStatsStackOverflows = 7,
+    kRayOrigin = 0, kRayDirection = 3, kRayTMax = 6, kRayMode = 7, kRaySurfaceTriangle = 8,
+    kResultTriangle = 0, kResultT = 1, kResultNodesVisited = 2, kResultTrianglesTested = 3,
+    kResultMaxStackDepth = 4, kResultStackOverflows = 5,
 };
 
 // The enums above and the structs must agree, and every record must be whole words: a kernel
@@ -148,6 +212,26 @@ TRAX_LAYOUT_WORD(SceneHeader, materials, kHeaderMaterials);
 TRAX_LAYOUT_WORD(SceneHeader, triangles, kHeaderTriangles);
 TRAX_LAYOUT_WORD(SceneHeader, bvh_nodes, kHeaderBvhNodes);
 TRAX_LAYOUT_WORD(SceneHeader, framebuffer, kHeaderFramebuffer);
+TRAX_LAYOUT_WORD(SceneHeader, thread_stats, kHeaderThreadStats);
+TRAX_LAYOUT_WORD(SceneHeader, rays, kHeaderRays);
+TRAX_LAYOUT_WORD(SceneHeader, ray_results, kHeaderRayResults);
+TRAX_LAYOUT_WORD(ThreadStats, primary_rays, kStatsPrimaryRays);
+TRAX_LAYOUT_WORD(ThreadStats, shadow_rays, kStatsShadowRays);
+TRAX_LAYOUT_WORD(ThreadStats, nodes_visited_lo, kStatsNodesVisited);
+TRAX_LAYOUT_WORD(ThreadStats, triangles_tested_lo, kStatsTrianglesTested);
+TRAX_LAYOUT_WORD(ThreadStats, max_stack_depth, kStatsMaxStackDepth);
+TRAX_LAYOUT_WORD(ThreadStats, stack_overflows, kStatsStackOverflows);
+TRAX_LAYOUT_WORD(Ray, origin, kRayOrigin);
+TRAX_LAYOUT_WORD(Ray, direction, kRayDirection);
+TRAX_LAYOUT_WORD(Ray, t_max, kRayTMax);
+TRAX_LAYOUT_WORD(Ray, mode, kRayMode);
+TRAX_LAYOUT_WORD(Ray, surface_triangle, kRaySurfaceTriangle);
+TRAX_LAYOUT_WORD(RayResult, triangle, kResultTriangle);
+TRAX_LAYOUT_WORD(RayResult, t, kResultT);
+TRAX_LAYOUT_WORD(RayResult, nodes_visited, kResultNodesVisited);
+TRAX_LAYOUT_WORD(RayResult, triangles_tested, kResultTrianglesTested);
+TRAX_LAYOUT_WORD(RayResult, max_stack_depth, kResultMaxStackDepth);
+TRAX_LAYOUT_WORD(RayResult, stack_overflows, kResultStackOverflows);
 TRAX_LAYOUT_WORD(Camera, eye, kCameraEye);
 TRAX_LAYOUT_WORD(Camera, corner, kCameraCorner);
 TRAX_LAYOUT_WORD(Camera, right, kCameraRight);
@@ -172,7 +256,8 @@ static_assert(sizeof(PointLight) == 24);
 static_assert(sizeof(Material) == 12);
 static_assert(sizeof(Triangle) == 40);
 static_assert(sizeof(BvhNode) == 32, "the BVH node is one half cache line");
-static_assert(sizeof(SceneHeader) == 100);
+static_assert(sizeof(SceneHeader) == 124);
+static_assert(sizeof(ThreadStats) == 32 && sizeof(Ray) == 36 && sizeof(RayResult) == 24);
 
 /// Rounds a word address up to the section alignment.
 constexpr int32_t align_section(int32_t word) {
@@ -181,12 +266,14 @@ constexpr int32_t align_section(int32_t word) {
 
 /// THE section placement rule. Given a header whose counts (and image size) are filled in,
 /// assigns every section's addr and total_words: sections follow the header in the order
-/// camera, lights, materials, triangles, bvh_nodes, framebuffer, each aligned to
+/// camera, lights, materials, triangles, bvh_nodes, framebuffer, thread_stats, rays,
+/// ray_results, each aligned to
 /// kSectionAlignWords; empty sections take no space. The framebuffer count is set from the
-/// image size. The scene compiler calls this; tests check images against it.
+/// image size, the ray_results count from the rays count. The scene compiler calls this; tests check images against it.
 constexpr void place_sections(SceneHeader& h) {
     h.camera.count = 1;
     h.framebuffer.count = h.image_width * h.image_height;
+    h.ray_results.count = h.rays.count;
     struct Section {
         SectionRef* ref;
         int32_t record_words;
@@ -195,6 +282,8 @@ constexpr void place_sections(SceneHeader& h) {
         {&h.camera, kCameraWords},       {&h.lights, kPointLightWords},
         {&h.materials, kMaterialWords},  {&h.triangles, kTriangleWords},
         {&h.bvh_nodes, kBvhNodeWords},   {&h.framebuffer, kPixelWords},
+        {&h.thread_stats, kThreadStatsWords}, {&h.rays, kRayWords},
+        {&h.ray_results, kRayResultWords},
     };
     int32_t next = align_section(kHeaderWords);
     for (const Section& s : order) {

@@ -80,12 +80,22 @@ TRAX_CSR_FUNCTION(trax_tp_id, 0xCC3)
 TRAX_CSR_FUNCTION(trax_tm_size, 0xCC4)
 #undef TRAX_CSR_FUNCTION
 
+/// Write `TRAX_USES_BVH;` at file scope in a kernel that traverses the BVH: it defines the marker
+/// symbol trax::layout::kUsesBvhSymbol (a one-instruction function the link script keeps), and
+/// tpsim then builds the BVH and puts it in the memory image; other kernels get none.
+#define TRAX_USES_BVH                                                              \
+    asm(".pushsection .text.trax_uses_bvh, \"ax\", @progbits\n"                  \
+        ".globl trax_uses_bvh\n.type trax_uses_bvh, @function\n"                  \
+        "trax_uses_bvh:\n  ret\n.size trax_uses_bvh, . - trax_uses_bvh\n.popsection")
+
 #else  // the native twin
 
 #include <stdexcept>
 #include <string>
 
 #define TRAX_INLINE inline
+/// The twin is told about the BVH by the host, which reads the marker from the ELF.
+#define TRAX_USES_BVH static_assert(true)
 
 namespace trax::native {
 

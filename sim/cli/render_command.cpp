@@ -1,5 +1,7 @@
 // `tpsim render SCENE`: renders a scene with a kernel on the simulated chip (or its native twin),
 // writes the image and prints the statistics.
+#include <chrono>
+#include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -7,6 +9,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include "commands.hpp"
 #include "sim/core/error.hpp"
@@ -30,15 +33,60 @@ std::filesystem::path resolve_kernel(const std::string& kernel) {
     return built;
 }
 
+/// One self-overwriting status line on stderr while the chip model runs, redrawn at most ten
+/// times a second; nothing at all when stderr is not a terminal (logs, pipes, CI).
+class ProgressLine {
+public:
+    ProgressLine() : enabled_(isatty(STDERR_FILENO) == 1) {}
+    ~ProgressLine() { clear(); }
+    ProgressLine(const ProgressLine&) = delete;
+    ProgressLine& operator=(const ProgressLine&) = delete;
+
+    void update(const render::Progress& p) {
+        if (!enabled_ || p.pixels == 0) return;
+        const auto now = Clock::now();
+        const double share = double(p.pixels_done) / double(p.pixels);
+        if (!started_) {  // the first report starts the clock: scene loading is over by then
+            started_ = true;
+            start_ = last_ = now;
+            start_share_ = share;
+            return;
+        }
+        if (now - last_ < std::chrono::milliseconds(100)) return;
+        last_ = now;
+        const double elapsed = std::chrono::duration<double>(now - start_).count();
+        const std::string left =
+            share > start_share_
+                ? fmt::format("~{:.0f} s left", elapsed * (1 - share) / (share - start_share_))
+                : "estimating time left";
+        fmt::print(stderr, "\r{:5.1f}% of pixels, {} cycles, {}\033[K", 100 * share, p.cycles, left);
+        shown_ = true;
+    }
+
+    void clear() {
+        if (shown_) fmt::print(stderr, "\r\033[K");
+        shown_ = false;
+    }
+
+private:
+    using Clock = std::chrono::steady_clock;
+    bool enabled_;
+    bool started_ = false;
+    bool shown_ = false;
+    double start_share_ = 0;
+    Clock::time_point start_, last_;
+};
+
 struct RenderCommandOptions {
     std::string scene;
     std::string output;
-    std::string kernel = "primary_brute";
+    std::string kernel = "tracer";
     std::string config;
     std::vector<std::string> overrides;
-    std::string bvh = "none";
+    std::string bvh = "sweep";
     uint32_t max_leaf = 8;
     bool native = false;
+    std::string timing = "cycle";
     std::string stats_json;
     uint64_t max_instructions = uint64_t(1) << 32;
 };
@@ -47,22 +95,24 @@ int run_render(const RenderCommandOptions& o) {
     render::RenderOptions options;
     options.scene = o.scene;
     options.kernel = resolve_kernel(o.kernel);
-    options.engine = o.native ? render::Engine::native : render::Engine::functional;
+    options.engine = o.native             ? render::Engine::native
+                     : o.timing == "cycle" ? render::Engine::timing
+                                           : render::Engine::functional;
     options.max_instructions = o.max_instructions;
     if (!o.config.empty()) options.chip = timing::load_config(o.config);
     for (const std::string& assignment : o.overrides) timing::apply_override(options.chip, assignment);
-    if (o.bvh == "none") {
-        options.bvh.reset();
-    } else {
-        options.bvh->builder = o.bvh == "binned" ? scene::BvhBuilder::binned : scene::BvhBuilder::sweep;
-        options.bvh->max_leaf_size = o.max_leaf;
-    }
+    options.bvh.builder = o.bvh == "binned" ? scene::BvhBuilder::binned : scene::BvhBuilder::sweep;
+    options.bvh.max_leaf_size = o.max_leaf;
 
+    ProgressLine progress_line;
+    options.on_progress = [&](const render::Progress& p) { progress_line.update(p); };
     const render::RenderResult result = render::render(options);
+    progress_line.clear();
     const std::filesystem::path output =
         o.output.empty() ? std::filesystem::path(o.scene).stem().string() + ".png" : o.output;
     render::write_image(output, result.rgb, result.scene.width, result.scene.height);
 
+    fmt::print("# chip configuration (resolved)\n{}\n", timing::to_toml(options.chip));
     render::print_summary(options, result, std::cout);
     fmt::print("image    {}\n\n", output.string());
     stats::Registry registry;
@@ -72,6 +122,13 @@ int run_render(const RenderCommandOptions& o) {
         std::ofstream json(o.stats_json);
         stats::print_json(registry, json);
         if (!json) throw Error(fmt::format("cannot write statistics to '{}'", o.stats_json));
+        // The JSON holds numbers only; the configuration that produced them goes beside it.
+        const std::filesystem::path config_path =
+            std::filesystem::path(o.stats_json).replace_extension(".config.toml");
+        std::ofstream config(config_path);
+        config << timing::to_toml(options.chip);
+        if (!config)
+            throw Error(fmt::format("cannot write the configuration to '{}'", config_path.string()));
     }
     return 0;
 }
@@ -92,15 +149,23 @@ Command add_render_command(CLI::App& app) {
         ->check(CLI::ExistingFile);
     command->add_option("-s,--set", o->overrides,
                         "Override one chip configuration field, e.g. --set chip.num_tms=8");
-    command->add_option("--bvh", o->bvh, "BVH builder, or none for brute-force kernels")
-        ->check(CLI::IsMember({"sweep", "binned", "none"}))
+    command->add_option("--bvh", o->bvh,
+                        "BVH builder, used when the kernel traverses a BVH (TRAX_USES_BVH)")
+        ->check(CLI::IsMember({"sweep", "binned"}))
         ->capture_default_str();
     command->add_option("--max-leaf", o->max_leaf, "Most triangles in one BVH leaf")
         ->check(CLI::Range(1, 8))
         ->capture_default_str();
     command->add_flag("--native", o->native,
                       "Run the kernel's native twin on the host instead of the simulator");
-    command->add_option("--stats-json", o->stats_json, "Also write the statistics as JSON here");
+    command->add_option("--timing", o->timing,
+                        "cycle: the cycle-level chip model (cycles, stalls, caches, DRAM); "
+                        "none: the functional simulator only (fast, same image)")
+        ->check(CLI::IsMember({"cycle", "none"}))
+        ->capture_default_str();
+    command->add_option("--stats-json", o->stats_json,
+                        "Also write the statistics as JSON here, and the chip configuration "
+                        "beside it (PATH with extension .config.toml)");
     command->add_option("--max-instructions", o->max_instructions,
                         "Instructions a thread may run before it is stopped as a runaway")
         ->check(CLI::PositiveNumber)

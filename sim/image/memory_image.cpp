@@ -1,5 +1,6 @@
 #include "memory_image.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -70,7 +71,8 @@ std::vector<layout::BvhNode> compile_bvh(const scene::Bvh& bvh) {
 
 }  // namespace
 
-MemoryImage build_memory_image(const scene::Scene& scene, const scene::Bvh* bvh) {
+MemoryImage build_memory_image(const scene::Scene& scene, const scene::Bvh* bvh, uint32_t threads,
+                               std::span<const layout::Ray> rays) {
     if (scene.width == 0 || scene.height == 0)
         throw Error("scene has an empty image (width or height is 0)");
     if (scene.triangles.empty()) throw Error("scene has no triangles");
@@ -100,13 +102,18 @@ MemoryImage build_memory_image(const scene::Scene& scene, const scene::Bvh* bvh)
     h.materials.count = checked_count(scene.materials.size(), "materials");
     h.triangles.count = checked_count(scene.triangles.size(), "triangles");
     h.bvh_nodes.count = checked_count(nodes.size(), "BVH nodes");
+    h.thread_stats.count = checked_count(threads, "threads");
+    h.rays.count = checked_count(rays.size(), "rays");
     const uint64_t pixels = uint64_t(scene.width) * scene.height;
     if (pixels > uint64_t(std::numeric_limits<int32_t>::max() / 16))
         throw Error(fmt::format("image {}x{} is too large for the 32-bit memory image",
                                 scene.width, scene.height));
     const uint64_t estimate = uint64_t(h.triangles.count) * layout::kTriangleWords +
                               uint64_t(h.bvh_nodes.count) * layout::kBvhNodeWords +
-                              pixels * layout::kPixelWords + 4096;
+                              pixels * layout::kPixelWords +
+                              uint64_t(threads) * layout::kThreadStatsWords +
+                              uint64_t(rays.size()) * (layout::kRayWords + layout::kRayResultWords) +
+                              4096;
     // Global memory spans kGlobalBase..kLocalTop - kStackGuard in the guest address space.
     constexpr uint64_t kMaxWords =
         (trax::map::kLocalTop - trax::map::kStackGuard - trax::map::kGlobalBase) / 4;
@@ -146,6 +153,8 @@ MemoryImage build_memory_image(const scene::Scene& scene, const scene::Bvh* bvh)
     }
     for (size_t i = 0; i < nodes.size(); ++i)
         write(image.words, h.bvh_nodes.addr + int32_t(i) * layout::kBvhNodeWords, nodes[i]);
+    for (size_t i = 0; i < rays.size(); ++i)
+        write(image.words, h.rays.addr + int32_t(i) * layout::kRayWords, rays[i]);
 
     const auto section = [](const char* name, const layout::SectionRef& ref, int32_t words) {
         return SectionSize{name, uint32_t(ref.count), uint64_t(ref.count) * uint64_t(words) * 4};
@@ -159,6 +168,9 @@ MemoryImage build_memory_image(const scene::Scene& scene, const scene::Bvh* bvh)
         section("triangles", h.triangles, layout::kTriangleWords),
         section("bvh_nodes", h.bvh_nodes, layout::kBvhNodeWords),
         section("framebuffer", h.framebuffer, layout::kPixelWords),
+        section("thread_stats", h.thread_stats, layout::kThreadStatsWords),
+        section("rays", h.rays, layout::kRayWords),
+        section("ray_results", h.ray_results, layout::kRayResultWords),
     };
     return image;
 }
@@ -167,6 +179,29 @@ std::vector<float> read_framebuffer(const layout::SceneHeader& header, const uin
     std::vector<float> rgb(size_t(header.framebuffer.count) * layout::kPixelWords);
     std::memcpy(rgb.data(), words + header.framebuffer.addr, rgb.size() * sizeof(float));
     return rgb;
+}
+
+TraversalTotals read_thread_stats(const layout::SceneHeader& header, const uint32_t* words) {
+    TraversalTotals totals;
+    const auto wide = [](const uint32_t* lo) { return uint64_t(lo[0]) | uint64_t(lo[1]) << 32; };
+    for (int32_t i = 0; i < header.thread_stats.count; ++i) {
+        const uint32_t* r = words + header.thread_stats.addr + i * layout::kThreadStatsWords;
+        totals.primary_rays += r[layout::kStatsPrimaryRays];
+        totals.shadow_rays += r[layout::kStatsShadowRays];
+        totals.nodes_visited += wide(r + layout::kStatsNodesVisited);
+        totals.triangles_tested += wide(r + layout::kStatsTrianglesTested);
+        totals.max_stack_depth = std::max(totals.max_stack_depth, r[layout::kStatsMaxStackDepth]);
+        totals.stack_overflows += r[layout::kStatsStackOverflows];
+    }
+    return totals;
+}
+
+std::vector<layout::RayResult> read_ray_results(const layout::SceneHeader& header,
+                                                const uint32_t* words) {
+    std::vector<layout::RayResult> results(size_t(header.ray_results.count));
+    std::memcpy(results.data(), words + header.ray_results.addr,
+                results.size() * sizeof(layout::RayResult));
+    return results;
 }
 
 }  // namespace tpsim::image

@@ -2,6 +2,7 @@
 // image defined by kernel/scene_layout.hpp, holding only the sections the scene needs.
 #pragma once
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -29,8 +30,26 @@ struct MemoryImage {
 
 /// Lays the scene out. With a BVH, triangles are stored in leaf order and nodes with sibling
 /// pairs adjacent, as the traversal kernel expects; without one, the BVH section is left out.
-/// Throws tpsim::Error if the scene does not fit the layout (e.g. more than 2^31 words).
-MemoryImage build_memory_image(const scene::Scene& scene, const scene::Bvh* bvh = nullptr);
+/// One zeroed ThreadStats record per thread (`threads` of them); `rays` (for the ray_query
+/// kernel) and room for as many RayResults. Throws tpsim::Error if the scene does not fit the
+/// layout (e.g. more than 2^31 words).
+MemoryImage build_memory_image(const scene::Scene& scene, const scene::Bvh* bvh, uint32_t threads,
+                               std::span<const trax::layout::Ray> rays = {});
+
+/// The kernel's per-thread statistics records summed (ThreadStats; max for the depth).
+struct TraversalTotals {
+    uint64_t primary_rays = 0, shadow_rays = 0;
+    uint64_t nodes_visited = 0, triangles_tested = 0;
+    uint32_t max_stack_depth = 0;
+    uint64_t stack_overflows = 0;
+    uint64_t rays() const { return primary_rays + shadow_rays; }
+};
+TraversalTotals read_thread_stats(const trax::layout::SceneHeader& header,
+                                  const uint32_t* global_words);
+
+/// The ray_query kernel's results, one per ray.
+std::vector<trax::layout::RayResult> read_ray_results(const trax::layout::SceneHeader& header,
+                                                      const uint32_t* global_words);
 
 /// The framebuffer's linear RGB floats, row 0 at the top, read back from global memory.
 std::vector<float> read_framebuffer(const trax::layout::SceneHeader& header,

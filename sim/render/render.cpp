@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "native_twin.hpp"
+#include "timing_run.hpp"
 #include "sim/core/elf_loader.hpp"
 #include "sim/core/error.hpp"
 #include "sim/core/machine.hpp"
@@ -19,15 +20,15 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 }
 
 /// Runs the kernel ELF on the functional machine over the image, in place.
-InstructionCounts run_functional(const RenderOptions& options, image::MemoryImage& image,
-                                 uint32_t threads) {
+InstructionCounts run_functional(const std::filesystem::path& kernel, image::MemoryImage& image,
+                                 const timing::ChipConfig& chip, uint64_t max_instructions) {
     core::MachineConfig config;
-    config.threads = threads;
-    config.threads_per_tm = options.chip.chip.tps_per_tm;
-    config.local_store_bytes = options.chip.tp.local_store_bytes;
+    config.threads = chip.chip.num_tms * chip.chip.tps_per_tm;
+    config.threads_per_tm = chip.chip.tps_per_tm;
+    config.local_store_bytes = chip.tp.local_store_bytes;
     config.global_bytes = uint32_t(image.bytes());
-    config.max_instructions = options.max_instructions;
-    core::Machine machine(core::load_elf(options.kernel), config);
+    config.max_instructions = max_instructions;
+    core::Machine machine(core::load_elf(kernel), config);
     std::memcpy(machine.memory().global().data(), image.words.data(), image.bytes());
     machine.run();
     std::memcpy(image.words.data(), machine.memory().global().data(), image.bytes());
@@ -42,6 +43,29 @@ InstructionCounts run_functional(const RenderOptions& options, image::MemoryImag
 
 }  // namespace
 
+bool kernel_uses_bvh(const std::filesystem::path& kernel_elf) {
+    const core::Program program = core::load_elf(kernel_elf.string());
+    for (const core::Symbol& symbol : program.functions)
+        if (symbol.name == trax::layout::kUsesBvhSymbol) return true;
+    return false;
+}
+
+InstructionCounts run_kernel(const std::filesystem::path& kernel_elf, Engine engine,
+                             image::MemoryImage& image, const timing::ChipConfig& chip,
+                             uint64_t max_instructions) {
+    switch (engine) {
+        case Engine::functional: return run_functional(kernel_elf, image, chip, max_instructions);
+        case Engine::native:
+            run_native_twin(native_twin_of(kernel_elf), image.words,
+                            chip.chip.num_tms * chip.chip.tps_per_tm, chip.chip.num_tms,
+                            chip.chip.tps_per_tm);
+            break;
+        case Engine::timing:
+            return run_timing(kernel_elf, image, chip, max_instructions)->instructions;
+    }
+    return {};
+}
+
 RenderResult render(const RenderOptions& options) {
     RenderResult result;
     auto start = std::chrono::steady_clock::now();
@@ -49,26 +73,36 @@ RenderResult render(const RenderOptions& options) {
     result.load_seconds = seconds_since(start);
 
     std::optional<scene::Bvh> bvh;
-    if (options.bvh) {
+    if (kernel_uses_bvh(options.kernel)) {
         start = std::chrono::steady_clock::now();
-        bvh = scene::build_bvh(result.scene.triangles, *options.bvh);
+        scene::BvhConfig config = options.bvh;
+        config.traversal_stack_entries = trax::layout::kTraversalStackEntries;
+        bvh = scene::build_bvh(result.scene.triangles, config);
         result.bvh_seconds = seconds_since(start);
         result.bvh = bvh->stats;
     }
-    result.image = image::build_memory_image(result.scene, bvh ? &*bvh : nullptr);
     result.threads = options.chip.chip.num_tms * options.chip.chip.tps_per_tm;
+    result.image = image::build_memory_image(result.scene, bvh ? &*bvh : nullptr, result.threads);
 
     start = std::chrono::steady_clock::now();
-    switch (options.engine) {
-        case Engine::functional:
-            result.instructions = run_functional(options, result.image, result.threads);
-            break;
-        case Engine::native:
-            run_native_twin(native_twin_of(options.kernel), result.image.words, result.threads,
-                            options.chip.chip.num_tms, options.chip.chip.tps_per_tm);
-            break;
+    if (options.engine == Engine::timing) {
+        result.timing = run_timing(options.kernel, result.image, options.chip,
+                                   options.max_instructions,
+                                   uint64_t(result.scene.width) * result.scene.height,
+                                   options.on_progress);
+        result.instructions = result.timing->instructions;
+    } else {
+        result.instructions = run_kernel(options.kernel, options.engine, result.image,
+                                         options.chip, options.max_instructions);
     }
     result.run_seconds = seconds_since(start);
+    result.traversal = image::read_thread_stats(result.image.header, result.image.words.data());
+    if (result.traversal.stack_overflows > 0)
+        throw Error(fmt::format(
+            "the kernel's BVH traversal stack overflowed {} times: it holds {} entries but the BVH "
+            "is {} levels deep; build the BVH with traversal_stack_entries <= the kernel's stack",
+            result.traversal.stack_overflows, trax::layout::kTraversalStackEntries,
+            result.bvh ? result.bvh->max_depth : 0));
     result.rgb = image::read_framebuffer(result.image.header, result.image.words.data());
     return result;
 }

@@ -4,6 +4,8 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -18,17 +20,30 @@ namespace tpsim::render {
 enum class Engine {
     functional,  ///< the simulator without timing: every instruction, no cycles
     native,      ///< the kernel's native twin on the host: the reference image
+    timing,      ///< the simulator under the cycle-level chip model (sim/timing): cycles too
 };
+
+/// How far a cycle-level run has come, for a progress display.
+struct Progress {
+    uint64_t pixels_done = 0;  ///< global register 0 (the kernels' pixel counter), capped
+    uint64_t pixels = 0;       ///< pixels in the image
+    uint64_t cycles = 0;       ///< simulated so far
+};
+using ProgressCallback = std::function<void(const Progress&)>;
+
+struct TimingRun;  // timing_run.hpp
 
 struct RenderOptions {
     std::filesystem::path scene;   ///< scene file (.toml) or a bare mesh
     std::filesystem::path kernel;  ///< kernel ELF; its twin is found next to it
     Engine engine = Engine::functional;
-    /// BVH to build, or none for kernels that do not traverse one (it is then left out of the
-    /// memory image).
-    std::optional<scene::BvhConfig> bvh = scene::BvhConfig{};
+    /// The BVH to build when the kernel traverses one (its ELF defines the TRAX_USES_BVH
+    /// marker); other kernels get no BVH in their memory image. render() sets the depth limit
+    /// to the kernels' stack capacity (trax::layout::kTraversalStackEntries).
+    scene::BvhConfig bvh;
     timing::ChipConfig chip;       ///< shape (TMs x TPs) and local-store size
     uint64_t max_instructions = uint64_t(1) << 32;  ///< per thread, for runaway kernels
+    ProgressCallback on_progress;  ///< Engine::timing calls it now and then while it runs
 };
 
 /// Instruction counts of a simulated run.
@@ -42,13 +57,26 @@ struct RenderResult {
     scene::Scene scene;                      ///< as loaded (triangles included)
     std::optional<scene::BvhStats> bvh;      ///< when a BVH was built
     image::MemoryImage image;                ///< the memory image after the run
+    image::TraversalTotals traversal;        ///< the kernel's per-thread statistics, summed
     std::vector<float> rgb;                  ///< framebuffer, linear RGB, row 0 at the top
     InstructionCounts instructions;          ///< zero for the native engine
     uint32_t threads = 0;
+    std::shared_ptr<const TimingRun> timing;  ///< Engine::timing: the chip and its counters
     double load_seconds = 0, bvh_seconds = 0, run_seconds = 0;  ///< host wall clock
 };
 
-/// Runs the whole pipeline. Throws tpsim::Error (or a scene::SceneError) with one clear line.
+/// Runs the whole pipeline. Throws tpsim::Error (or a scene::SceneError) with one clear line,
+/// also when a traversal stack overflowed.
 RenderResult render(const RenderOptions& options);
+
+/// Does the kernel ELF traverse a BVH (define trax::layout::kUsesBvhSymbol)?
+bool kernel_uses_bvh(const std::filesystem::path& kernel_elf);
+
+/// Runs a kernel over a memory image, in place, on the chosen engine with the chip's thread
+/// shape: the building block of render() and of tests that bring their own image (ray_query).
+/// Returns the instruction counts (zero for the native twin).
+InstructionCounts run_kernel(const std::filesystem::path& kernel_elf, Engine engine,
+                             image::MemoryImage& image, const timing::ChipConfig& chip,
+                             uint64_t max_instructions = uint64_t(1) << 32);
 
 }  // namespace tpsim::render

@@ -5,6 +5,8 @@
 #include <fmt/format.h>
 #include <fmt/ostream.h>
 
+#include "timing_run.hpp"
+
 namespace tpsim::render {
 
 void register_stats(const RenderResult& r, stats::Registry& reg) {
@@ -39,6 +41,20 @@ void register_stats(const RenderResult& r, stats::Registry& reg) {
         number("host/bvh_seconds", [&r] { return r.bvh_seconds; }, "BVH build time", "s");
     }
 
+    const image::TraversalTotals& t = r.traversal;
+    const auto per_ray = [&t](uint64_t count) {
+        return t.rays() > 0 ? double(count) / double(t.rays()) : 0.0;
+    };
+    number("rays/total", [&t] { return t.rays(); }, "rays traced (primary + shadow)");
+    number("rays/primary", [&t] { return t.primary_rays; }, "closest-hit (camera) rays");
+    number("rays/shadow", [&t] { return t.shadow_rays; }, "any-hit (shadow) rays");
+    number("traversal/nodes_per_ray", [&t, per_ray] { return per_ray(t.nodes_visited); },
+           "BVH node boxes tested per ray, on average", "nodes");
+    number("traversal/triangles_per_ray", [&t, per_ray] { return per_ray(t.triangles_tested); },
+           "ray/triangle tests per ray, on average", "triangles");
+    number("traversal/max_stack_depth", [&t] { return t.max_stack_depth; },
+           "most traversal-stack entries any ray used", "entries");
+
     if (r.instructions.total > 0) {
         reg.add_counter("instructions/total", r.instructions.total, "instructions executed");
         for (size_t fu = 0; fu < r.instructions.per_fu.size(); ++fu)
@@ -49,6 +65,17 @@ void register_stats(const RenderResult& r, stats::Registry& reg) {
             if (r.instructions.per_op[op] != 0)
                 reg.add_counter(fmt::format("instructions/op/{}", isa::info(isa::Op(op)).mnemonic),
                                 r.instructions.per_op[op], "instructions with this opcode");
+    }
+    if (r.timing) {
+        r.timing->chip->register_stats(reg);
+        if (reg.contains("rays/total"))
+            reg.add_derived("chip/rays_per_second",
+                            [&reg] {
+                                const double seconds = reg.value("chip/frame_seconds");
+                                return seconds > 0 ? reg.value("rays/total") / seconds : 0.0;
+                            },
+                            "rays traced per simulated second (rays/total / chip/frame_seconds)",
+                            "rays/s");
     }
     number("host/load_seconds", [&r] { return r.load_seconds; }, "scene load and import time", "s");
     number("host/run_seconds", [&r] { return r.run_seconds; }, "kernel run time on the host", "s");
@@ -63,7 +90,9 @@ void print_summary(const RenderOptions& options, const RenderResult& r, std::ost
                options.scene.string(), r.scene.triangles.size(), r.scene.lights.size(),
                r.scene.materials.size(), r.scene.width, r.scene.height, r.scene.samples_per_pixel);
     fmt::print(out, "kernel   {} on {} ({} TMs x {} TPs = {} threads)\n", options.kernel.string(),
-               options.engine == Engine::native ? "the native twin" : "the functional simulator",
+               options.engine == Engine::native   ? "the native twin"
+               : options.engine == Engine::timing ? "the cycle-level chip model"
+                                                  : "the functional simulator",
                options.chip.chip.num_tms, options.chip.chip.tps_per_tm, r.threads);
     fmt::print(out, "memory   {:.1f} KiB:", double(r.image.bytes()) / 1024);
     for (const image::SectionSize& s : r.image.sections)
@@ -75,6 +104,24 @@ void print_summary(const RenderOptions& options, const RenderResult& r, std::ost
                    r.bvh->depth_limited_nodes
                        ? fmt::format(" (depth limit shaped {} nodes)", r.bvh->depth_limited_nodes)
                        : "");
+    if (r.traversal.rays() > 0)
+        fmt::print(out, "rays     {} ({} primary, {} shadow): {:.1f} nodes, {:.1f} triangles per ray, "
+                        "stack depth up to {}\n",
+                   r.traversal.rays(), r.traversal.primary_rays, r.traversal.shadow_rays,
+                   double(r.traversal.nodes_visited) / double(r.traversal.rays()),
+                   double(r.traversal.triangles_tested) / double(r.traversal.rays()),
+                   r.traversal.max_stack_depth);
+    if (r.timing) {
+        const timing::Chip& chip = *r.timing->chip;
+        const double seconds = double(chip.cycles()) / (options.chip.chip.clock_mhz * 1e6);
+        fmt::print(out, "timing   {} cycles = {:.3f} ms at {} MHz ({:.1f} frames/s), {:.2f} "
+                        "instructions per TP-cycle{}\n",
+                   chip.cycles(), seconds * 1e3, options.chip.chip.clock_mhz, 1 / seconds,
+                   double(r.instructions.total) / (double(chip.cycles()) * r.threads),
+                   r.traversal.rays() > 0
+                       ? fmt::format(", {:.1f} M rays/s", double(r.traversal.rays()) / seconds / 1e6)
+                       : "");
+    }
     if (r.instructions.total > 0)
         fmt::print(out, "run      {} instructions in {:.3f} s = {:.1f} M simulated instructions/s\n",
                    r.instructions.total, r.run_seconds,

@@ -14,7 +14,6 @@ render::RenderOptions options_for(const char* scene, const char* kernel, render:
     o.scene = std::filesystem::path(TPSIM_SOURCE_DIR) / "scenes" / scene;
     o.kernel = std::filesystem::path(TPSIM_KERNEL_DIR) / kernel;
     o.engine = engine;
-    o.bvh.reset();
     return o;
 }
 
