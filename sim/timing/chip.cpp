@@ -80,7 +80,7 @@ Chip::Chip(const ChipConfig& config, InstructionSource& source)
 
 Chip::~Chip() = default;
 
-uint64_t Chip::run(uint64_t max_cycles) {
+uint64_t Chip::run(uint64_t max_cycles, const ProgressHook& on_progress) {
     uint64_t last_progress = 0, last_progress_cycle = 0;
     auto busy = [&] {
         for (const auto& tm : tms_)
@@ -98,6 +98,7 @@ uint64_t Chip::run(uint64_t max_cycles) {
         tick_shared(now);
         for (auto& tm : tms_) tick_tm(*tm, now);
         cycles_ = now + 1;
+        if (on_progress && cycles_ % kProgressInterval == 0) on_progress(cycles_);
         if (progress_ != last_progress) {
             last_progress = progress_;
             last_progress_cycle = now;

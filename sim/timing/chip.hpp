@@ -19,6 +19,7 @@
 #include <array>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -60,10 +61,15 @@ public:
     Chip(const ChipConfig& config, InstructionSource& source);
     ~Chip();
 
+    /// Called by run() every kProgressInterval cycles with the cycle count, e.g. for a progress
+    /// display; it must not touch the chip or its source.
+    using ProgressHook = std::function<void(uint64_t cycles)>;
+    static constexpr uint64_t kProgressInterval = 1 << 16;
+
     /// Runs until every thread has exited and all memory traffic has drained; returns the
     /// cycle count. Throws std::runtime_error if nothing progresses for a long time (deadlock)
     /// or `max_cycles` pass.
-    uint64_t run(uint64_t max_cycles = UINT64_MAX);
+    uint64_t run(uint64_t max_cycles = UINT64_MAX, const ProgressHook& on_progress = {});
 
     uint64_t cycles() const { return cycles_; }
     /// Registers every counter under tm<i>/..., l2/<j>/..., dram/..., global_registers/...,

@@ -1,0 +1,42 @@
+#include "timing_run.hpp"
+
+#include <algorithm>
+#include <cstring>
+
+#include "sim/core/elf_loader.hpp"
+
+namespace tpsim::render {
+
+std::shared_ptr<TimingRun> run_timing(const std::filesystem::path& kernel_elf,
+                                      image::MemoryImage& image, const timing::ChipConfig& chip,
+                                      uint64_t max_instructions, uint64_t pixels,
+                                      const ProgressCallback& on_progress) {
+    core::MachineConfig config = timing::machine_config_for(chip);
+    config.global_bytes = uint32_t(image.bytes());
+    config.max_instructions = max_instructions;
+
+    auto run = std::make_shared<TimingRun>();
+    run->machine = std::make_unique<core::Machine>(core::load_elf(kernel_elf), config);
+    core::Machine& machine = *run->machine;
+    std::memcpy(machine.memory().global().data(), image.words.data(), image.bytes());
+    run->source = std::make_unique<timing::MachineSource>(machine);
+    run->chip = std::make_unique<timing::Chip>(chip, *run->source);
+
+    timing::Chip::ProgressHook hook;
+    if (on_progress)
+        hook = [&](uint64_t cycles) {
+            // Threads take one pixel past the end before they stop, hence the cap.
+            on_progress({std::min<uint64_t>(machine.global_register(0), pixels), pixels, cycles});
+        };
+    run->chip->run(UINT64_MAX, hook);
+    std::memcpy(image.words.data(), machine.memory().global().data(), image.bytes());
+
+    InstructionCounts& counts = run->instructions;
+    counts.total = machine.counters().instructions;
+    counts.per_op = machine.counters().per_op;
+    for (size_t op = 0; op < counts.per_op.size(); ++op)
+        counts.per_fu[size_t(isa::info(isa::Op(op)).fu)] += counts.per_op[op];
+    return run;
+}
+
+}  // namespace tpsim::render

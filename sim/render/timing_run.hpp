@@ -1,0 +1,33 @@
+// The cycle-level engine: the functional machine executes each instruction when the chip model
+// (sim/timing) fetches it, and the chip decides when it issues and completes.
+#pragma once
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+
+#include "render.hpp"
+#include "sim/core/machine.hpp"
+#include "sim/image/memory_image.hpp"
+#include "sim/timing/chip.hpp"
+#include "sim/timing/machine_source.hpp"
+
+namespace tpsim::render {
+
+/// A finished cycle-level run. The chip keeps its counters for register_stats(); the machine
+/// and source stay alive beside it because the chip refers to them.
+struct TimingRun {
+    std::unique_ptr<core::Machine> machine;
+    std::unique_ptr<timing::MachineSource> source;
+    std::unique_ptr<timing::Chip> chip;
+    InstructionCounts instructions;
+};
+
+/// Runs `kernel_elf` over `image` (in place) on the chip `chip`. `pixels` scales the progress
+/// reports, which come every timing::Chip::kProgressInterval cycles. Throws core::Fault on a
+/// guest fault and std::runtime_error on a timing deadlock.
+std::shared_ptr<TimingRun> run_timing(const std::filesystem::path& kernel_elf,
+                                      image::MemoryImage& image, const timing::ChipConfig& chip,
+                                      uint64_t max_instructions, uint64_t pixels = 0,
+                                      const ProgressCallback& on_progress = {});
+
+}  // namespace tpsim::render

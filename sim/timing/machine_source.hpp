@@ -1,0 +1,34 @@
+// The functional machine (sim/core) as the timing model's instruction source: thread ids are
+// tm * tps_per_tm + tp on both sides, so MachineConfig::threads_per_tm must equal
+// chip.tps_per_tm (machine_config_for() builds a matching one).
+#pragma once
+#include "sim/core/machine.hpp"
+#include "timing/chip.hpp"
+
+namespace tpsim::timing {
+
+/// The machine shape a chip needs: one thread per TP, the chip's TM size and local store.
+inline core::MachineConfig machine_config_for(const ChipConfig& chip) {
+    core::MachineConfig config;
+    config.threads = chip.chip.num_tms * chip.chip.tps_per_tm;
+    config.threads_per_tm = chip.chip.tps_per_tm;
+    config.local_store_bytes = chip.tp.local_store_bytes;
+    return config;
+}
+
+class MachineSource final : public InstructionSource {
+public:
+    explicit MachineSource(core::Machine& machine) : machine_(machine) {}
+
+    uint32_t next_pc(uint32_t thread) const override { return machine_.thread(thread).hart.pc; }
+
+    StepInfo step(uint32_t thread) override {
+        const core::StepRecord r = machine_.step(thread);
+        return {r.pc, r.insn, r.mem_address, r.mem_bytes, r.mem_store, r.taken, r.exited};
+    }
+
+private:
+    core::Machine& machine_;
+};
+
+}  // namespace tpsim::timing
