@@ -34,12 +34,18 @@ using ElfHandle = std::unique_ptr<Elf, ElfCloser>;
 
 std::string machine_name(uint16_t machine) {
     switch (machine) {
-        case EM_386: return "x86 (3)";
-        case EM_X86_64: return "x86-64 (62)";
-        case EM_ARM: return "ARM (40)";
-        case EM_AARCH64: return "AArch64 (183)";
-        case EM_MIPS: return "MIPS (8)";
-        default: return std::to_string(machine);
+    case EM_386:
+        return "x86 (3)";
+    case EM_X86_64:
+        return "x86-64 (62)";
+    case EM_ARM:
+        return "ARM (40)";
+    case EM_AARCH64:
+        return "AArch64 (183)";
+    case EM_MIPS:
+        return "MIPS (8)";
+    default:
+        return std::to_string(machine);
     }
 }
 
@@ -102,8 +108,8 @@ std::string permissions(const Segment& s) {
 void check_segment_placement(const Segment& s, const std::string& name) {
     using namespace trax::map;
     const uint64_t end = uint64_t(s.vaddr) + s.memsz;
-    const std::string where = fmt::format("segment [{:#010x}, {:#010x}) ({})", s.vaddr, end,
-                                          permissions(s));
+    const std::string where =
+        fmt::format("segment [{:#010x}, {:#010x}) ({})", s.vaddr, end, permissions(s));
     if (s.vaddr < kCodeBase)
         reject(name, fmt::format("{} lies below the code base {:#010x} (the null guard); link "
                                  "with the kernel linker script or -Ttext={:#x}",
@@ -120,8 +126,8 @@ void check_segment_placement(const Segment& s, const std::string& name) {
         reject(name, fmt::format("executable {} is not 4-byte aligned; align .text to 4", where));
 }
 
-std::vector<Segment> read_segments(Elf* elf, const Elf32_Ehdr& eh,
-                                   std::span<const uint8_t> image, const std::string& name) {
+std::vector<Segment> read_segments(Elf* elf, const Elf32_Ehdr& eh, std::span<const uint8_t> image,
+                                   const std::string& name) {
     std::vector<Segment> segments;
     for (size_t i = 0; i < eh.e_phnum; ++i) {
         GElf_Phdr ph;
@@ -234,7 +240,7 @@ void read_lines(Elf* elf, Program& program) {
                      [](const auto& a, const auto& b) { return a.address < b.address; });
 }
 
-}  // namespace
+} // namespace
 
 const Symbol* Program::function_at(uint32_t pc) const {
     auto it = std::upper_bound(functions.begin(), functions.end(), pc,
@@ -242,7 +248,8 @@ const Symbol* Program::function_at(uint32_t pc) const {
     if (it == functions.begin()) return nullptr;
     // Among symbols at the same address the sized one sorts first; walk back to it.
     const uint32_t address = std::prev(it)->address;
-    while (it != functions.begin() && std::prev(it)->address == address) --it;
+    while (it != functions.begin() && std::prev(it)->address == address)
+        --it;
     const Symbol& s = *it;
     if (s.size != 0 && pc - s.address >= s.size) return nullptr;
     return &s;
@@ -281,7 +288,8 @@ Program load_elf(std::span<const uint8_t> image, const std::string& name) {
     std::vector<char> buffer(image.begin(), image.end());
     ElfHandle elf(elf_memory(buffer.data(), buffer.size()));
     if (!elf || elf_kind(elf.get()) != ELF_K_ELF)
-        reject(name, fmt::format("libelf cannot read it ({}); the file is damaged", elf_errmsg(-1)));
+        reject(name,
+               fmt::format("libelf cannot read it ({}); the file is damaged", elf_errmsg(-1)));
 
     Program program;
     program.name = name;
@@ -306,4 +314,4 @@ Program load_elf(const std::string& path) {
     return load_elf(bytes, path);
 }
 
-}  // namespace tpsim::core
+} // namespace tpsim::core

@@ -23,21 +23,21 @@ struct Segment {
 struct Symbol {
     std::string name;
     uint32_t address = 0;
-    uint32_t size = 0;  ///< 0 when the symbol carries no size (plain assembly labels)
+    uint32_t size = 0; ///< 0 when the symbol carries no size (plain assembly labels)
 };
 
 struct SourceLocation {
-    std::string file;  ///< file name as recorded by the compiler (no directory)
+    std::string file; ///< file name as recorded by the compiler (no directory)
     uint32_t line = 0;
 };
 
 /// Everything the simulator needs from the ELF; no libelf handles are kept.
 class Program {
-public:
-    std::string name;                ///< path or label, for messages
+  public:
+    std::string name; ///< path or label, for messages
     uint32_t entry = 0;
-    std::vector<Segment> segments;   ///< sorted by vaddr, non-overlapping
-    std::vector<Symbol> functions;   ///< sorted by address
+    std::vector<Segment> segments; ///< sorted by vaddr, non-overlapping
+    std::vector<Symbol> functions; ///< sorted by address
 
     /// The function containing pc, or the nearest preceding unsized label; nullptr if none.
     const Symbol* function_at(uint32_t pc) const;
@@ -52,7 +52,7 @@ public:
     struct LineRow {
         uint32_t address;
         uint32_t line;
-        uint32_t file;  ///< index into line_files
+        uint32_t file; ///< index into line_files
         bool end_sequence;
     };
     std::vector<LineRow> line_rows;
@@ -66,4 +66,4 @@ Program load_elf(const std::string& path);
 /// Same, from bytes already in memory; `name` is used in messages.
 Program load_elf(std::span<const uint8_t> image, const std::string& name);
 
-}  // namespace tpsim::core
+} // namespace tpsim::core

@@ -13,8 +13,8 @@ namespace tpsim::core {
 
 namespace {
 
-constexpr uint32_t kExitSyscall = 93;       // a7 value of exit(a0), as in Linux/newlib
-constexpr uint32_t kCauseIllegal = 2;       // mcause values of the privileged spec
+constexpr uint32_t kExitSyscall = 93; // a7 value of exit(a0), as in Linux/newlib
+constexpr uint32_t kCauseIllegal = 2; // mcause values of the privileged spec
 constexpr uint32_t kCauseEcallM = 11;
 constexpr unsigned kA0 = 10, kA7 = 17, kSp = 2;
 
@@ -26,25 +26,22 @@ struct AccessRecorder {
 };
 struct NoRecorder {};
 
-}  // namespace
+} // namespace
 
 /// The isa::execute environment of one thread. kRecord adds the bookkeeping step() reports; the
 /// fast path instantiates it away.
-template <bool kRecord>
-class ThreadEnv {
-public:
+template <bool kRecord> class ThreadEnv {
+  public:
     ThreadEnv(Machine& machine, uint32_t id)
         : machine_(machine), memory_(machine.memory_), thread_(machine.threads_[id]),
           h_(thread_.hart), id_(id), local_(machine.memory_.local_store(id).data()) {}
 
-    template <class T>
-    T load(uint32_t addr) {
+    template <class T> T load(uint32_t addr) {
         if constexpr (kRecord) access_ = {addr, uint8_t(sizeof(T)), false};
         return memory_.load<T>(addr, local_);
     }
 
-    template <class T>
-    void store(uint32_t addr, T value) {
+    template <class T> void store(uint32_t addr, T value) {
         if constexpr (kRecord) access_ = {addr, uint8_t(sizeof(T)), true};
         memory_.store<T>(addr, value, local_);
     }
@@ -67,17 +64,36 @@ public:
         // supplies real cycles. (instret itself is the hart's.)
         const uint64_t cycles = h_.instret;
         switch (csr) {
-            case c::kMhartid: value = id_; return true;
-            case c::kNthreads: value = m.thread_count(); return true;
-            case c::kTmid: value = id_ / per_tm; return true;
-            case c::kNtms: value = (m.thread_count() + per_tm - 1) / per_tm; return true;
-            case c::kTpid: value = id_ % per_tm; return true;
-            case c::kTmsize: value = per_tm; return true;
-            case c::kCycle: case c::kMcycle: case c::kTime: value = uint32_t(cycles); return true;
-            case c::kCycleH: case c::kMcycleH: case c::kTimeH:
-                value = uint32_t(cycles >> 32);
-                return true;
-            default: return false;
+        case c::kMhartid:
+            value = id_;
+            return true;
+        case c::kNthreads:
+            value = m.thread_count();
+            return true;
+        case c::kTmid:
+            value = id_ / per_tm;
+            return true;
+        case c::kNtms:
+            value = (m.thread_count() + per_tm - 1) / per_tm;
+            return true;
+        case c::kTpid:
+            value = id_ % per_tm;
+            return true;
+        case c::kTmsize:
+            value = per_tm;
+            return true;
+        case c::kCycle:
+        case c::kMcycle:
+        case c::kTime:
+            value = uint32_t(cycles);
+            return true;
+        case c::kCycleH:
+        case c::kMcycleH:
+        case c::kTimeH:
+            value = uint32_t(cycles >> 32);
+            return true;
+        default:
+            return false;
         }
     }
 
@@ -92,11 +108,11 @@ public:
             return;
         }
         if (h.mtvec != 0) return isa::trap(h, kCauseEcallM, 0);
-        throw GuestFault{FaultKind::UnsupportedEcall,
-                         fmt::format("with a7={}; tpsim only implements exit (a7={})", number,
-                                     kExitSyscall),
-                         "call exit through the kernel runtime, or install a trap handler in "
-                         "mtvec"};
+        throw GuestFault{
+            FaultKind::UnsupportedEcall,
+            fmt::format("with a7={}; tpsim only implements exit (a7={})", number, kExitSyscall),
+            "call exit through the kernel runtime, or install a trap handler in "
+            "mtvec"};
     }
 
     void ebreak(isa::Hart&) {
@@ -130,7 +146,7 @@ public:
     AccessRecorder access() const { return access_; }
     bool exited() const { return exited_; }
 
-private:
+  private:
     Machine& machine_;
     Memory& memory_;
     Thread& thread_;
@@ -145,14 +161,13 @@ void MachineConfig::validate() const {
     MemoryConfig{global_bytes, local_store_bytes, threads}.validate();
     if (threads_per_tm == 0) throw Error("threads per TM must be at least 1");
     if (quantum == 0) throw Error("scheduler quantum must be at least 1 instruction");
-    if (max_instructions == 0)
-        throw Error("--max-instructions must be at least 1");
+    if (max_instructions == 0) throw Error("--max-instructions must be at least 1");
 }
 
 Machine::Machine(Program program, const MachineConfig& config)
     : program_(std::move(program)), config_(config),
-      memory_(program_, MemoryConfig{config.global_bytes, config.local_store_bytes,
-                                     config.threads}) {
+      memory_(program_,
+              MemoryConfig{config.global_bytes, config.local_store_bytes, config.threads}) {
     config_.validate();
     // Decode the span of all executable segments once; words in gaps between them decode as
     // illegal and are reported as fetches outside the code.
@@ -168,7 +183,7 @@ Machine::Machine(Program program, const MachineConfig& config)
     threads_.resize(config_.threads);
     for (Thread& t : threads_) {
         t.hart.pc = program_.entry;
-        t.hart.reg[kSp] = trax::map::kLocalTop;  // the runtime may set it again; asm tests need not
+        t.hart.reg[kSp] = trax::map::kLocalTop; // the runtime may set it again; asm tests need not
     }
 }
 
@@ -192,12 +207,13 @@ void Machine::fault(uint32_t id, uint32_t pc, const GuestFault& what) {
 
 void Machine::fetch_fault(uint32_t id, uint32_t pc) {
     if (pc % 4 != 0 && pc - text_base_ < text_bytes_)
-        fault(id, pc, {FaultKind::Misaligned, "jump to a pc that is not 4-byte aligned",
-                       "a return address or function pointer is corrupt (stack smashed?)"});
+        fault(id, pc,
+              {FaultKind::Misaligned, "jump to a pc that is not 4-byte aligned",
+               "a return address or function pointer is corrupt (stack smashed?)"});
     fault(id, pc,
           {FaultKind::FetchOutsideCode,
-           fmt::format("fetch from {:#010x}, outside the code [{:#010x}, {:#010x})", pc,
-                       text_base_, text_base_ + text_bytes_),
+           fmt::format("fetch from {:#010x}, outside the code [{:#010x}, {:#010x})", pc, text_base_,
+                       text_base_ + text_bytes_),
            "a return address or function pointer is null or corrupt (stack smashed?)"});
 }
 
@@ -280,4 +296,4 @@ StepRecord Machine::step(uint32_t id) {
     return record;
 }
 
-}  // namespace tpsim::core
+} // namespace tpsim::core

@@ -38,8 +38,8 @@ constexpr uint32_t kParkedPc = 0;
 struct Thread {
     isa::Hart hart;
     ThreadState state = ThreadState::Running;
-    int32_t exit_code = 0;   ///< a0 of the exit ecall
-    uint32_t exit_pc = 0;    ///< address of the exit ecall (hart.pc is parked at kParkedPc)
+    int32_t exit_code = 0; ///< a0 of the exit ecall
+    uint32_t exit_pc = 0;  ///< address of the exit ecall (hart.pc is parked at kParkedPc)
     /// Instructions executed, including the exit ecall and trapping ones (which instret does
     /// not count); checked against max_instructions.
     uint64_t executed = 0;
@@ -47,25 +47,25 @@ struct Thread {
 
 /// What one instruction did, for the timing model (step()).
 struct StepRecord {
-    uint32_t pc = 0;                        ///< address of the instruction
-    const isa::Decoded* insn = nullptr;     ///< its pre-decoded form (registers, FU class)
-    uint32_t mem_address = 0;               ///< effective address when mem_bytes != 0
-    uint8_t mem_bytes = 0;                  ///< access size; 0 = no memory access
+    uint32_t pc = 0;                    ///< address of the instruction
+    const isa::Decoded* insn = nullptr; ///< its pre-decoded form (registers, FU class)
+    uint32_t mem_address = 0;           ///< effective address when mem_bytes != 0
+    uint8_t mem_bytes = 0;              ///< access size; 0 = no memory access
     bool mem_store = false;
-    bool taken = false;                     ///< control left the fall-through path (branch, jump, trap)
-    bool exited = false;                    ///< the instruction ended the thread
+    bool taken = false;  ///< control left the fall-through path (branch, jump, trap)
+    bool exited = false; ///< the instruction ended the thread
 };
 
 struct Counters {
     uint64_t instructions = 0;
-    std::array<uint64_t, size_t(isa::Op::Count)> per_op{};  ///< indexed by isa::Op
+    std::array<uint64_t, size_t(isa::Op::Count)> per_op{}; ///< indexed by isa::Op
 };
 
 /// Number of global registers for tp.atominc (all start at 0).
 constexpr uint32_t kGlobalRegisters = 256;
 
 class Machine {
-public:
+  public:
     Machine(Program program, const MachineConfig& config);
 
     /// Runs every thread to its exit, round-robin by thread id in fixed quanta, so results never
@@ -85,12 +85,10 @@ public:
     const Counters& counters() const { return counters_; }
     uint32_t global_register(uint32_t index) const { return global_registers_.at(index); }
 
-private:
-    template <bool kRecord>
-    friend class ThreadEnv;
+  private:
+    template <bool kRecord> friend class ThreadEnv;
 
-    template <bool kRecord>
-    void run_quantum(uint32_t id, uint64_t budget, StepRecord* record);
+    template <bool kRecord> void run_quantum(uint32_t id, uint64_t budget, StepRecord* record);
     [[noreturn]] void fault(uint32_t id, uint32_t pc, const GuestFault& what);
     [[noreturn]] void fetch_fault(uint32_t id, uint32_t pc);
     [[noreturn]] void limit_fault(uint32_t id);
@@ -101,10 +99,10 @@ private:
     Memory memory_;
     uint32_t text_base_ = 0;
     uint32_t text_bytes_ = 0;
-    std::vector<isa::Decoded> decoded_;   ///< the executable range, one entry per word
+    std::vector<isa::Decoded> decoded_; ///< the executable range, one entry per word
     std::vector<Thread> threads_;
     std::array<uint32_t, kGlobalRegisters> global_registers_{};
     Counters counters_;
 };
 
-}  // namespace tpsim::core
+} // namespace tpsim::core

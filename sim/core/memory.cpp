@@ -15,8 +15,7 @@ constexpr uint32_t kMaxLocalStore = 1u << 20;
 constexpr uint32_t kMaxGlobal = kLocalTop - kStackGuard - kGlobalBase;
 
 /// calloc leaves untouched pages unbacked, so large local stores cost only what threads use.
-template <class Buffer>
-Buffer zeroed(size_t bytes, const char* what) {
+template <class Buffer> Buffer zeroed(size_t bytes, const char* what) {
     Buffer buffer(static_cast<uint8_t*>(std::calloc(bytes ? bytes : 1, 1)));
     if (!buffer)
         throw Error(fmt::format("out of host memory allocating {} bytes of {}; reduce the thread "
@@ -25,9 +24,11 @@ Buffer zeroed(size_t bytes, const char* what) {
     return buffer;
 }
 
-std::string range(uint32_t base, uint64_t end) { return fmt::format("[{:#010x}, {:#010x})", base, end); }
+std::string range(uint32_t base, uint64_t end) {
+    return fmt::format("[{:#010x}, {:#010x})", base, end);
+}
 
-}  // namespace
+} // namespace
 
 void MemoryConfig::validate() const {
     if (local_store_bytes < kMinLocalStore || local_store_bytes > kMaxLocalStore ||
@@ -52,8 +53,8 @@ Memory::Memory(const Program& program, const MemoryConfig& config) {
     }
     global_buffer_ = zeroed<Buffer>(config.global_bytes, "global memory");
     global_ = {kGlobalBase, config.global_bytes, global_buffer_.get(), true};
-    local_stores_ = zeroed<Buffer>(size_t(config.threads) * config.local_store_bytes,
-                                   "local stores");
+    local_stores_ =
+        zeroed<Buffer>(size_t(config.threads) * config.local_store_bytes, "local stores");
     local_ = {kLocalTop - config.local_store_bytes, config.local_store_bytes, nullptr, true};
 }
 
@@ -69,23 +70,24 @@ uint32_t Memory::code_word(uint32_t addr) const {
 
 void Memory::fault(uint32_t addr, uint32_t bytes, bool store) const {
     const char* verb = store ? "writes" : "reads";
-    const std::string what = fmt::format("{} {} byte{} at {:#010x}", verb, bytes,
-                                         bytes == 1 ? "" : "s", addr);
+    const std::string what =
+        fmt::format("{} {} byte{} at {:#010x}", verb, bytes, bytes == 1 ? "" : "s", addr);
     if (addr < kCodeBase)
-        throw GuestFault{FaultKind::NullAccess,
-                         fmt::format("{}, inside the unmapped null guard {}", what,
-                                     range(0, kCodeBase)),
-                         "check for a null or uninitialised pointer"};
-    if (addr >= kLocalTop - kStackGuard && addr < local_.base)
         throw GuestFault{
-            FaultKind::StackOverflow,
-            fmt::format("{}, below the {}-byte local store {}", what, local_.size,
-                        range(local_.base, kLocalTop)),
-            "reduce recursion/locals or raise --local-store"};
+            FaultKind::NullAccess,
+            fmt::format("{}, inside the unmapped null guard {}", what, range(0, kCodeBase)),
+            "check for a null or uninitialised pointer"};
+    if (addr >= kLocalTop - kStackGuard && addr < local_.base)
+        throw GuestFault{FaultKind::StackOverflow,
+                         fmt::format("{}, below the {}-byte local store {}", what, local_.size,
+                                     range(local_.base, kLocalTop)),
+                         "reduce recursion/locals or raise --local-store"};
 
     const Region* region = nullptr;
-    if (addr - local_.base < local_.size) region = &local_;
-    else if (global_.holds(addr, 1)) region = &global_;
+    if (addr - local_.base < local_.size)
+        region = &local_;
+    else if (global_.holds(addr, 1))
+        region = &global_;
     for (const Region& r : program_regions_)
         if (r.holds(addr, 1)) region = &r;
 
@@ -120,4 +122,4 @@ void Memory::fault(uint32_t addr, uint32_t bytes, bool store) const {
                      "check pointer arithmetic and array bounds (see docs/memory-map.md)"};
 }
 
-}  // namespace tpsim::core
+} // namespace tpsim::core

@@ -29,7 +29,7 @@ struct MemoryConfig {
 /// is an alignment test, one or two range compares and a memcpy. Anything else is classified
 /// by a cold path that throws GuestFault.
 class Memory {
-public:
+  public:
     Memory(const Program& program, const MemoryConfig& config);
 
     /// Global memory, for the host to write the scene image and read the framebuffer.
@@ -42,22 +42,20 @@ public:
     uint32_t local_base() const { return local_.base; }
     uint32_t local_store_bytes() const { return local_.size; }
 
-    template <class T>
-    T load(uint32_t addr, uint8_t* local) const {
+    template <class T> T load(uint32_t addr, uint8_t* local) const {
         T value;
         std::memcpy(&value, locate(addr, sizeof(T), local, /*store=*/false), sizeof(T));
         return value;
     }
 
-    template <class T>
-    void store(uint32_t addr, T value, uint8_t* local) {
+    template <class T> void store(uint32_t addr, T value, uint8_t* local) {
         std::memcpy(locate(addr, sizeof(T), local, /*store=*/true), &value, sizeof(T));
     }
 
     /// Reads an instruction word of the program (for disassembly in messages); 0 if unmapped.
     uint32_t code_word(uint32_t addr) const;
 
-private:
+  private:
     struct Region {
         uint32_t base = 0;
         uint32_t size = 0;
@@ -89,11 +87,11 @@ private:
     [[noreturn]] void fault(uint32_t addr, uint32_t bytes, bool store) const;
 
     std::vector<Buffer> program_buffers_;
-    std::vector<Region> program_regions_;  ///< ELF segments, by address
+    std::vector<Region> program_regions_; ///< ELF segments, by address
     Buffer global_buffer_;
     Region global_;
-    Buffer local_stores_;  ///< threads x local_.size bytes, zeroed lazily by calloc
-    Region local_;         ///< the window; data is per thread
+    Buffer local_stores_; ///< threads x local_.size bytes, zeroed lazily by calloc
+    Region local_;        ///< the window; data is per thread
 };
 
-}  // namespace tpsim::core
+} // namespace tpsim::core

@@ -42,7 +42,7 @@ struct Patchable {
     Program parse() const { return load_elf(bytes, "patched.elf"); }
 };
 
-}  // namespace
+} // namespace
 
 TEST_CASE("the loader reads segments, entry and symbols of a linked program", "[sim][elf]") {
     const Program p = load_elf(guest_program("loadstore"));
@@ -55,9 +55,9 @@ TEST_CASE("the loader reads segments, entry and symbols of a linked program", "[
     const Segment& data = p.segments.back();
     CHECK(data.writable);
     CHECK_FALSE(data.executable);
-    CHECK(data.memsz == 4 + 8);              // .word + .space 8 (bss)
-    CHECK(data.bytes.size() == 4);           // only .data is in the file
-    CHECK(p.entry == text.vaddr);            // _start is the first thing in .text
+    CHECK(data.memsz == 4 + 8);    // .word + .space 8 (bss)
+    CHECK(data.bytes.size() == 4); // only .data is in the file
+    CHECK(p.entry == text.vaddr);  // _start is the first thing in .text
     REQUIRE(p.function_at(p.entry));
     CHECK(p.function_at(p.entry)->name == "_start");
     CHECK(p.describe_pc(p.entry + 8) == "_start+0x8");
@@ -105,8 +105,8 @@ TEST_CASE("the loader rejects truncated files at every stage", "[sim][elf]") {
     std::memcpy(&h, good.data(), sizeof h);
     Elf32_Phdr first;
     std::memcpy(&first, good.data() + h.e_phoff, sizeof first);
-    const size_t cuts[] = {2, EI_NIDENT - 1, 30, sizeof(Elf32_Ehdr) + 10,
-                           size_t(first.p_offset) + 8, good.size() - 1};
+    const size_t cuts[] = {
+        2, EI_NIDENT - 1, 30, sizeof(Elf32_Ehdr) + 10, size_t(first.p_offset) + 8, good.size() - 1};
     for (size_t cut : cuts) {
         INFO("truncated to " << cut << " bytes");
         const std::vector<uint8_t> part(good.begin(), good.begin() + cut);
@@ -183,6 +183,12 @@ TEST_CASE("the loader rejects patched headers with a message naming the problem"
         h.e_entry += 2;
         elf.set_header(h);
         REQUIRE_THROWS_WITH(elf.parse(), Catch::Contains("not 4-byte aligned"));
+    }
+    SECTION("writable and executable segment") {
+        Elf32_Phdr p = elf.phdr(elf.load(0));
+        p.p_flags |= PF_W;
+        elf.set_phdr(elf.load(0), p);
+        REQUIRE_THROWS_WITH(elf.parse(), Catch::Contains("writable and executable"));
     }
     SECTION("file size larger than memory size") {
         Elf32_Phdr p = elf.phdr(elf.load(0));

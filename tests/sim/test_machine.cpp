@@ -1,7 +1,7 @@
 #include <algorithm>
 #include <chrono>
-#include <ctime>
 #include <cstring>
+#include <ctime>
 
 #include <catch2/catch.hpp>
 #include <fmt/format.h>
@@ -45,11 +45,12 @@ std::string fault_message(Machine& m) {
     return "";
 }
 
-}  // namespace
+} // namespace
 
 TEST_CASE("instruction-class programs compute the expected results", "[sim][machine]") {
     // Each program exits with 0 when all of its checks pass, else with the failed check's number.
-    for (const char* name : {"alu", "muldiv", "branch", "loadstore", "float", "calls", "csr", "trap"}) {
+    for (const char* name :
+         {"alu", "muldiv", "branch", "loadstore", "float", "calls", "csr", "trap"}) {
         INFO("program " << name);
         Machine m = machine_for(name);
         m.run();
@@ -69,8 +70,7 @@ TEST_CASE("the exit ecall ends the thread with a0", "[sim][machine]") {
     CHECK(m.counters().per_op[size_t(isa::Op::addi)] == 2);
 }
 
-TEST_CASE("1024 threads each see their own ids and write them to global memory",
-          "[sim][machine]") {
+TEST_CASE("1024 threads each see their own ids and write them to global memory", "[sim][machine]") {
     constexpr uint32_t kThreads = 1024;
     Machine m = machine_for("hartid", {.threads = kThreads, .global_bytes = 8 * kThreads});
     m.run();
@@ -85,15 +85,15 @@ TEST_CASE("1024 threads each see their own ids and write them to global memory",
 TEST_CASE("tp.atominc hands out unique tickets across 1024 threads", "[sim][machine]") {
     constexpr uint32_t kThreads = 1024, kTicketsEach = 4;
     // A quantum of 3 interleaves the threads' loops mid-iteration.
-    Machine m = machine_for("atominc",
-                            {.threads = kThreads, .global_bytes = 4 * kThreads * kTicketsEach,
-                             .quantum = 3});
+    Machine m = machine_for(
+        "atominc",
+        {.threads = kThreads, .global_bytes = 4 * kThreads * kTicketsEach, .quantum = 3});
     m.run();
     CHECK(m.global_register(7) == kThreads * kTicketsEach);
     CHECK(m.global_register(6) == 0);
     std::vector<uint32_t> claimed(kThreads + 1, 0);
     for (uint32_t ticket = 0; ticket < kThreads * kTicketsEach; ++ticket) {
-        const uint32_t owner = global_word(m, ticket);  // mhartid + 1; 0 = never handed out
+        const uint32_t owner = global_word(m, ticket); // mhartid + 1; 0 = never handed out
         REQUIRE(owner >= 1);
         REQUIRE(owner <= kThreads);
         ++claimed[owner];
@@ -105,7 +105,7 @@ TEST_CASE("tp.atominc hands out unique tickets across 1024 threads", "[sim][mach
 TEST_CASE("faults name kind, thread, pc, function, instruction and a fix", "[sim][machine]") {
     struct Case {
         const char* program;
-        uint32_t victim_offset;  // of the faulting instruction in victim()
+        uint32_t victim_offset; // of the faulting instruction in victim()
         const char* kind;
         const char* detail;
     };
@@ -147,7 +147,8 @@ TEST_CASE("unbounded recursion is a stack overflow in the recursive function", "
     CHECK_THAT(message, Catch::Contains("(recurse+0x"));
     const uint32_t line = tpsim::test::line_of("stack_overflow.c", "RECURSE_LINE");
     CHECK_THAT(message, Catch::Contains(fmt::format("stack_overflow.c:{})", line)));
-    CHECK_THAT(message, Catch::Contains("below the 1024-byte local store [0x7ffffc00, 0x80000000)"));
+    CHECK_THAT(message,
+               Catch::Contains("below the 1024-byte local store [0x7ffffc00, 0x80000000)"));
     CHECK_THAT(message, Catch::EndsWith("reduce recursion/locals or raise --local-store"));
 }
 
@@ -164,7 +165,7 @@ TEST_CASE("a runaway thread stops at the instruction limit", "[sim][machine]") {
 TEST_CASE("a fault in one of 1024 threads names that thread", "[sim][machine]") {
     Machine m = machine_for("fault_thread17_ebreak", {.threads = 1024});
     CHECK_THAT(fault_message(m), Catch::StartsWith("breakpoint in thread 17 at pc"));
-    CHECK(m.thread(16).state == ThreadState::Exited);  // thread order by id within a round
+    CHECK(m.thread(16).state == ThreadState::Exited); // thread order by id within a round
     CHECK(m.thread(17).state == ThreadState::Faulted);
 }
 
@@ -173,47 +174,49 @@ TEST_CASE("step() reports each instruction's pc, memory access and control flow"
     Machine m = machine_for("loadstore");
     const uint32_t entry = m.program().entry;
     std::vector<StepRecord> trace;
-    while (m.thread(0).state == ThreadState::Running) trace.push_back(m.step(0));
+    while (m.thread(0).state == ThreadState::Running)
+        trace.push_back(m.step(0));
     CHECK(m.thread(0).exit_code == 0);
     REQUIRE(trace.size() > 10);
     CHECK(trace.front().pc == entry);
     CHECK(trace.back().exited);
     CHECK_FALSE(trace.back().taken);
-    const auto taken = std::count_if(trace.begin(), trace.end(),
-                                     [](const StepRecord& r) { return r.taken; });
-    CHECK(taken == 0);  // loadstore.S is straight-line code: CHECK's bne never branches
+    const auto taken =
+        std::count_if(trace.begin(), trace.end(), [](const StepRecord& r) { return r.taken; });
+    CHECK(taken == 0); // loadstore.S is straight-line code: CHECK's bne never branches
     CHECK(trace.back().insn->op == isa::Op::ecall);
     // The first load of the program is `lw t1, 0(t0)` of the .data word.
-    const auto first_load = std::find_if(trace.begin(), trace.end(), [](const StepRecord& r) {
-        return r.insn->op == isa::Op::lw;
-    });
+    const auto first_load = std::find_if(
+        trace.begin(), trace.end(), [](const StepRecord& r) { return r.insn->op == isa::Op::lw; });
     REQUIRE(first_load != trace.end());
     CHECK(first_load->mem_bytes == 4);
     CHECK_FALSE(first_load->mem_store);
     CHECK(first_load->mem_address == m.program().segments.back().vaddr);
-    const auto first_sb = std::find_if(trace.begin(), trace.end(), [](const StepRecord& r) {
-        return r.insn->op == isa::Op::sb;
-    });
+    const auto first_sb = std::find_if(
+        trace.begin(), trace.end(), [](const StepRecord& r) { return r.insn->op == isa::Op::sb; });
     REQUIRE(first_sb != trace.end());
     CHECK(first_sb->mem_bytes == 1);
     CHECK(first_sb->mem_store);
     for (const StepRecord& r : trace)
         if (r.insn->op == isa::Op::addi) CHECK(r.mem_bytes == 0);
-    CHECK_THROWS_AS(m.step(0), Error);  // the thread has exited
+    CHECK_THROWS_AS(m.step(0), Error); // the thread has exited
 }
 
 TEST_CASE("step() marks taken branches and jumps", "[sim][machine]") {
     Machine m = machine_for("branch");
     std::vector<StepRecord> trace;
-    while (m.thread(0).state == ThreadState::Running) trace.push_back(m.step(0));
+    while (m.thread(0).state == ThreadState::Running)
+        trace.push_back(m.step(0));
     REQUIRE(m.thread(0).exit_code == 0);
     // branch.S: the six checks "branch to fail if wrong" fall through; the next six branch.
     std::vector<const StepRecord*> branches;
     for (const StepRecord& r : trace)
         if (isa::info(r.insn->op).fu == isa::FuClass::Branch) branches.push_back(&r);
     REQUIRE(branches.size() > 12);
-    for (size_t i = 0; i < 6; ++i) CHECK_FALSE(branches[i]->taken);
-    for (size_t i = 6; i < 12; ++i) CHECK(branches[i]->taken);
+    for (size_t i = 0; i < 6; ++i)
+        CHECK_FALSE(branches[i]->taken);
+    for (size_t i = 6; i < 12; ++i)
+        CHECK(branches[i]->taken);
     for (const StepRecord* r : branches)
         if (r->insn->op == isa::Op::jal || r->insn->op == isa::Op::jalr) CHECK(r->taken);
 }

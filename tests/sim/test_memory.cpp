@@ -34,15 +34,15 @@ FaultKind fault_of(const std::function<void()>& access) {
     return FaultKind::Unmapped;
 }
 
-}  // namespace
+} // namespace
 
 TEST_CASE("memory maps program segments with their permissions", "[sim][memory]") {
     Memory m(tiny_program(), {.global_bytes = 64, .local_store_bytes = 256, .threads = 2});
     uint8_t* local = m.local_store(0).data();
-    CHECK(m.load<uint32_t>(kCodeBase + 0x100, local) == 0x04030201u);  // little-endian
+    CHECK(m.load<uint32_t>(kCodeBase + 0x100, local) == 0x04030201u); // little-endian
     CHECK(m.load<int8_t>(kCodeBase + 0x107, local) == 8);
     CHECK(m.load<uint32_t>(kCodeBase + 0x1000, local) == 0x09090909u);
-    CHECK(m.load<uint32_t>(kCodeBase + 0x100c, local) == 0u);  // bss part is zero
+    CHECK(m.load<uint32_t>(kCodeBase + 0x100c, local) == 0u); // bss part is zero
     m.store<uint32_t>(kCodeBase + 0x100c, 0xdeadbeef, local);
     CHECK(m.load<uint16_t>(kCodeBase + 0x100e, local) == 0xdeadu);
     CHECK(fault_of([&] { m.store<uint32_t>(kCodeBase + 0x100, 1, local); }) ==
@@ -63,7 +63,8 @@ TEST_CASE("global memory is shared and visible to the host", "[sim][memory]") {
 TEST_CASE("local stores are private per thread and overflow is detected", "[sim][memory]") {
     Memory m(tiny_program(), {.global_bytes = 0, .local_store_bytes = 256, .threads = 3});
     CHECK(m.local_base() == kLocalTop - 256);
-    for (uint32_t t = 0; t < 3; ++t) m.store<uint32_t>(kLocalTop - 4, 100 + t, m.local_store(t).data());
+    for (uint32_t t = 0; t < 3; ++t)
+        m.store<uint32_t>(kLocalTop - 4, 100 + t, m.local_store(t).data());
     for (uint32_t t = 0; t < 3; ++t)
         CHECK(m.load<uint32_t>(kLocalTop - 4, m.local_store(t).data()) == 100 + t);
     CHECK(m.local_store(2)[252] == 102);
@@ -85,11 +86,10 @@ TEST_CASE("memory faults: null, unmapped, misaligned", "[sim][memory]") {
     CHECK(fault_of([&] { m.load<uint32_t>(kCodeBase - 4, local); }) == FaultKind::NullAccess);
     CHECK(fault_of([&] { m.load<uint32_t>(kCodeBase + 0x200, local); }) == FaultKind::Unmapped);
     CHECK(fault_of([&] { m.load<uint32_t>(0x4000'0000, local); }) == FaultKind::Unmapped);
-    CHECK(fault_of([&] { m.load<uint32_t>(kCodeBase + 0x1002, local); }) ==
-          FaultKind::Misaligned);
+    CHECK(fault_of([&] { m.load<uint32_t>(kCodeBase + 0x1002, local); }) == FaultKind::Misaligned);
     CHECK(fault_of([&] { m.load<uint16_t>(kGlobalBase + 1, local); }) == FaultKind::Misaligned);
     CHECK(fault_of([&] { m.store<uint32_t>(kLocalTop - 6, 0, local); }) == FaultKind::Misaligned);
-    CHECK(m.load<uint8_t>(kGlobalBase + 1, local) == 0);  // bytes have no alignment
+    CHECK(m.load<uint8_t>(kGlobalBase + 1, local) == 0); // bytes have no alignment
     try {
         m.store<uint32_t>(kLocalTop - 260, 1, local);
         FAIL("no fault");
@@ -107,7 +107,7 @@ TEST_CASE("memory configuration is validated", "[sim][memory]") {
     CHECK_THROWS_AS(Memory(p, {.global_bytes = 0, .local_store_bytes = 4100, .threads = 1}), Error);
     CHECK_THROWS_AS(Memory(p, {.global_bytes = 0, .local_store_bytes = 2u << 20, .threads = 1}),
                     Error);
-    CHECK_THROWS_AS(Memory(p, {.global_bytes = 0x7000'0000, .local_store_bytes = 256, .threads = 1}),
-                    Error);
+    CHECK_THROWS_AS(
+        Memory(p, {.global_bytes = 0x7000'0000, .local_store_bytes = 256, .threads = 1}), Error);
     CHECK_NOTHROW(Memory(p, {.global_bytes = 0, .local_store_bytes = 1u << 20, .threads = 4}));
 }
