@@ -79,3 +79,27 @@ TEST_CASE("A bare mesh gets a camera that sees all of it, a light and a material
     const glm::vec3 to_light = scene.lights[0].position - centre;
     CHECK(scene.lights[0].color.x / glm::dot(to_light, to_light) == Approx(1.0).epsilon(1e-4));
 }
+
+TEST_CASE("Every truncation of a valid OBJ, PLY and OFF file loads or fails cleanly", "[import][robustness]") {
+    const std::pair<std::string, std::string> files[] = {
+        {"cut.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nf 1 3 4\n"},
+        {"cut.ply", "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+                    "element face 2\nproperty list uchar int vertex_indices\nend_header\n"
+                    "0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n"},
+        {"cut.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n4 0 1 2 3\n"},
+    };
+    for (const auto& [name, contents] : files)
+        for (size_t length = 0; length <= contents.size(); ++length) {
+            INFO(name << " cut to " << length << " bytes");
+            const auto path = write_file(name, contents.substr(0, length));
+            // Only two outcomes are allowed: triangles, or a runtime_error naming the file.
+            std::string outcome;
+            try {
+                outcome = import_mesh(path).triangles.empty() ? "no triangles and no error" : "ok";
+            } catch (const std::runtime_error& e) {
+                outcome = e.what();
+            }
+            INFO(outcome);
+            CHECK((outcome == "ok" || outcome.find(name) != std::string::npos));
+        }
+}
