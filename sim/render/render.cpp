@@ -70,6 +70,8 @@ RenderResult render(const RenderOptions& options) {
     RenderResult result;
     auto start = std::chrono::steady_clock::now();
     result.scene = scene::load_scene(options.scene);
+    if (options.image_width != 0) result.scene.width = options.image_width;
+    if (options.image_height != 0) result.scene.height = options.image_height;
     result.load_seconds = seconds_since(start);
 
     std::optional<scene::Bvh> bvh;

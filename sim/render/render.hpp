@@ -41,6 +41,8 @@ struct RenderOptions {
     /// marker); other kernels get no BVH in their memory image. render() sets the depth limit
     /// to the kernels' stack capacity (trax::layout::kTraversalStackEntries).
     scene::BvhConfig bvh;
+    /// Overrides the scene file's image size when non-zero (tests render small images).
+    uint32_t image_width = 0, image_height = 0;
     timing::ChipConfig chip;       ///< shape (TMs x TPs) and local-store size
     uint64_t max_instructions = uint64_t(1) << 32;  ///< per thread, for runaway kernels
     ProgressCallback on_progress;  ///< Engine::timing calls it now and then while it runs

@@ -1,0 +1,391 @@
+// Stiff and extreme ray-tracing cases (docs/robustness.md), traced by the ray_query kernel
+// through the tracer's BVH traversal, on the functional simulator AND the native twin: every
+// result must agree bit for bit between the two, and meet the geometric expectation.
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <map>
+#include <utility>
+
+#include <catch2/catch.hpp>
+
+#include "sim/image/memory_image.hpp"
+#include "sim/render/render.hpp"
+#include "sim/scene/bvh.hpp"
+
+using namespace tpsim;
+using trax::layout::Ray;
+using trax::layout::RayResult;
+
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+using Mesh = std::vector<scene::Triangle>;
+
+/// The unit cube [0,1]^3, each face an n x n grid of quads (two triangles each), outward
+/// winding. Grid vertices are computed once per face from integers, so shared edges and
+/// vertices are bit-identical between neighbouring triangles: the mesh is closed.
+Mesh grid_cube(int n) {
+    Mesh mesh;
+    for (int axis = 0; axis < 3; ++axis)
+        for (int side = 0; side < 2; ++side) {
+            const auto point = [&](int i, int j) {
+                glm::vec3 p;
+                p[axis] = float(side);
+                p[(axis + 1) % 3] = float(i) / float(n);
+                p[(axis + 2) % 3] = float(j) / float(n);
+                return p;
+            };
+            for (int i = 0; i < n; ++i)
+                for (int j = 0; j < n; ++j) {
+                    const glm::vec3 a = point(i, j), b = point(i + 1, j), c = point(i + 1, j + 1),
+                                    d = point(i, j + 1);
+                    if (side == 1) {
+                        mesh.push_back({a, b, c});
+                        mesh.push_back({a, c, d});
+                    } else {
+                        mesh.push_back({a, c, b});
+                        mesh.push_back({a, d, c});
+                    }
+                }
+        }
+    return mesh;
+}
+
+/// Icosahedron subdivided `levels` times, vertices on the unit sphere. Each edge midpoint is
+/// created once and shared, so the mesh is closed.
+Mesh icosphere(int levels) {
+    const float t = (1.0f + std::sqrt(5.0f)) / 2.0f;
+    std::vector<glm::vec3> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
+                                {0, -1, t}, {0, 1, t}, {0, -1, -t}, {0, 1, -t},
+                                {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+    for (glm::vec3& p : v) p = glm::normalize(p);
+    std::vector<std::array<uint32_t, 3>> faces = {
+        {0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+        {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+        {3, 8, 9},  {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+    for (int level = 0; level < levels; ++level) {
+        std::map<std::pair<uint32_t, uint32_t>, uint32_t> midpoints;
+        const auto midpoint = [&](uint32_t a, uint32_t b) {
+            const auto key = std::minmax(a, b);
+            const auto [it, added] = midpoints.try_emplace({key.first, key.second}, 0);
+            if (added) {
+                it->second = uint32_t(v.size());
+                v.push_back(glm::normalize(v[a] + v[b]));
+            }
+            return it->second;
+        };
+        std::vector<std::array<uint32_t, 3>> finer;
+        for (const auto& f : faces) {
+            const uint32_t ab = midpoint(f[0], f[1]), bc = midpoint(f[1], f[2]),
+                           ca = midpoint(f[2], f[0]);
+            finer.push_back({f[0], ab, ca});
+            finer.push_back({f[1], bc, ab});
+            finer.push_back({f[2], ca, bc});
+            finer.push_back({ab, bc, ca});
+        }
+        faces = std::move(finer);
+    }
+    Mesh mesh;
+    for (const auto& f : faces) mesh.push_back({v[f[0]], v[f[1]], v[f[2]]});
+    return mesh;
+}
+
+Mesh transformed(Mesh mesh, float scale, glm::vec3 offset) {
+    for (scene::Triangle& t : mesh)
+        for (glm::vec3* p : {&t.v0, &t.v1, &t.v2}) *p = *p * scale + offset;
+    return mesh;
+}
+
+Ray make_ray(glm::vec3 origin, glm::vec3 dir, float t_max, int mode = trax::layout::kRayClosestHit,
+             int surface_triangle = -1) {
+    return Ray{{origin.x, origin.y, origin.z}, {dir.x, dir.y, dir.z}, t_max, mode, surface_triangle};
+}
+
+struct Queries {
+    scene::Bvh bvh;
+    std::vector<RayResult> results;  ///< one per ray, identical on both engines
+    /// The scene triangle behind an image (leaf-order) triangle index.
+    uint32_t scene_triangle(int32_t image_index) const { return bvh.triangle_order[image_index]; }
+};
+
+scene::Bvh bvh_for(const Mesh& mesh) {
+    scene::BvhConfig config;
+    config.traversal_stack_entries = trax::layout::kTraversalStackEntries;
+    return scene::build_bvh(mesh, config);
+}
+
+/// Runs ray_query over `rays` on both engines; REQUIREs that they agree bit for bit.
+Queries run_queries(const Mesh& mesh, const std::vector<Ray>& rays) {
+    Queries q{bvh_for(mesh), {}};
+    scene::Scene s;
+    s.triangles = mesh;
+    s.materials.resize(1);
+    s.width = s.height = 1;
+    timing::ChipConfig chip;
+    chip.chip.num_tms = 1;
+    chip.chip.tps_per_tm = 4;
+    const std::filesystem::path kernel = std::filesystem::path(TPSIM_KERNEL_DIR) / "ray_query.elf";
+    // A finite instruction budget: a ray that hung the traversal would fail the run.
+    const uint64_t budget = 20000 * uint64_t(rays.size()) + 100000;
+
+    std::vector<RayResult> per_engine[2];
+    const render::Engine engines[2] = {render::Engine::functional, render::Engine::native};
+    for (int e = 0; e < 2; ++e) {
+        image::MemoryImage img = image::build_memory_image(s, &q.bvh, 4, rays);
+        render::run_kernel(kernel, engines[e], img, chip, budget);
+        per_engine[e] = image::read_ray_results(img.header, img.words.data());
+        const image::TraversalTotals totals = image::read_thread_stats(img.header, img.words.data());
+        CHECK(totals.rays() == rays.size());
+        CHECK(totals.stack_overflows == 0);
+    }
+    REQUIRE(per_engine[0].size() == rays.size());
+    REQUIRE(per_engine[1].size() == rays.size());
+    size_t differing = 0;
+    for (size_t i = 0; i < rays.size(); ++i)
+        differing += std::memcmp(&per_engine[0][i], &per_engine[1][i], sizeof(RayResult)) != 0;
+    INFO(differing << " of " << rays.size() << " results differ between simulator and twin");
+    REQUIRE(differing == 0);
+    q.results = std::move(per_engine[0]);
+    return q;
+}
+
+/// Every distinct vertex and edge midpoint of the mesh.
+std::vector<glm::vec3> vertices_and_edge_midpoints(const Mesh& mesh) {
+    std::vector<glm::vec3> targets;
+    const auto add = [&targets](glm::vec3 p) {
+        for (const glm::vec3& q : targets)
+            if (q == p) return;
+        targets.push_back(p);
+    };
+    for (const scene::Triangle& t : mesh) {
+        add(t.v0);
+        add(t.v1);
+        add(t.v2);
+        add((t.v0 + t.v1) * 0.5f);
+        add((t.v1 + t.v2) * 0.5f);
+        add((t.v2 + t.v0) * 0.5f);
+    }
+    return targets;
+}
+
+/// Rays from `inside` aimed exactly at every vertex and edge midpoint, closest- and any-hit:
+/// a closed mesh must catch every one (zero leaks) at t ~ 1 (the target is on the surface).
+void check_no_leaks(const Mesh& mesh, glm::vec3 inside) {
+    const std::vector<glm::vec3> targets = vertices_and_edge_midpoints(mesh);
+    std::vector<Ray> rays;
+    for (const glm::vec3& target : targets) {
+        rays.push_back(make_ray(inside, target - inside, kInf));
+        rays.push_back(make_ray(inside, target - inside, kInf, trax::layout::kRayAnyHit));
+    }
+    const Queries q = run_queries(mesh, rays);
+    size_t leaks = 0, closest_off = 0;
+    for (size_t i = 0; i < rays.size(); ++i) {
+        const RayResult& r = q.results[i];
+        if (r.triangle < 0 || !std::isfinite(r.t)) ++leaks;
+        // Closest hit of a ray aimed at a surface point of a convex or star-shaped mesh.
+        else if (i % 2 == 0 && std::abs(r.t - 1.0f) > 1e-4f) ++closest_off;
+    }
+    INFO(targets.size() << " targets, " << leaks << " leaks, " << closest_off
+                        << " closest hits not at the target");
+    CHECK(leaks == 0);
+    CHECK(closest_off == 0);
+}
+
+}  // namespace
+
+TEST_CASE("robustness: rays at every vertex and edge of closed meshes never leak", "[robustness]") {
+    const Mesh cube = grid_cube(3), sphere = icosphere(2);
+    struct Placement {
+        const char* name;
+        float scale;
+        glm::vec3 offset;
+    };
+    // 1e5 is translated with a mesh of size 100: float spacing there is 1/128.
+    const Placement placements[] = {{"unit", 1.0f, glm::vec3(0.0f)},
+                                    {"scaled 1e-4", 1e-4f, glm::vec3(0.0f)},
+                                    {"scaled 1e4", 1e4f, glm::vec3(0.0f)},
+                                    {"translated 1e5", 100.0f, glm::vec3(1e5f, -1e5f, 1e5f)}};
+    for (const Placement& p : placements) {
+        SECTION(std::string("grid cube, ") + p.name) {
+            // The centre, and an off-centre point: different directions hit different edges.
+            check_no_leaks(transformed(cube, p.scale, p.offset), glm::vec3(0.5f) * p.scale + p.offset);
+            check_no_leaks(transformed(cube, p.scale, p.offset),
+                           glm::vec3(0.3f, 0.55f, 0.7f) * p.scale + p.offset);
+        }
+        SECTION(std::string("icosphere, ") + p.name) {
+            check_no_leaks(transformed(sphere, p.scale, p.offset), p.offset);
+            check_no_leaks(transformed(sphere, p.scale, p.offset),
+                           glm::vec3(0.2f, -0.3f, 0.1f) * p.scale + p.offset);
+        }
+    }
+}
+
+TEST_CASE("robustness: grazing rays inside a closed cube always hit, at the right distance",
+          "[robustness]") {
+    const Mesh cube = grid_cube(4);
+    std::vector<Ray> rays;
+    std::vector<float> expected;
+    // From just under the top face, almost parallel to it: exits through the side x = 1 at
+    // t = 1 - 0.1 (direction x component 1) or clips the top face first.
+    for (float rise : {0.0f, 1e-9f, 1e-6f, 1e-3f}) {
+        for (float below : {1e-7f, 1e-4f}) {
+            const glm::vec3 origin(0.1f, 0.37f, 1.0f - below);
+            const glm::vec3 dir(1.0f, 0.0f, rise);
+            rays.push_back(make_ray(origin, dir, kInf));
+            // The float origin's distance to the top face, exact (Sterbenz).
+            const float gap = 1.0f - origin.z;
+            expected.push_back(std::min(0.9f, gap / std::max(rise, 1e-30f)));
+        }
+    }
+    const Queries q = run_queries(cube, rays);
+    for (size_t i = 0; i < rays.size(); ++i) {
+        INFO("ray " << i);
+        CHECK(q.results[i].triangle >= 0);
+        CHECK(q.results[i].t == Approx(expected[i]).epsilon(1e-4));
+    }
+}
+
+TEST_CASE("robustness: axis-aligned rays with the origin on BVH box planes", "[robustness]") {
+    // A 4x4 grid per face: leaf boxes have planes at multiples of 1/4 inside the cube.
+    const Mesh cube = grid_cube(4);
+    const scene::Bvh bvh = bvh_for(cube);
+    std::vector<Ray> rays;
+    std::vector<float> expected;
+    for (const scene::BvhNode& node : bvh.nodes)
+        for (int axis = 0; axis < 3; ++axis)
+            for (float plane : {node.bounds.lo[axis], node.bounds.hi[axis]}) {
+                if (plane <= 0.0f || plane >= 1.0f) continue;  // only planes inside the cube
+                for (int dir_axis = 0; dir_axis < 3; ++dir_axis)
+                    for (float sign : {-1.0f, 1.0f}) {
+                        glm::vec3 origin(0.3f, 0.6f, 0.45f);
+                        origin[axis] = plane;
+                        glm::vec3 dir(0.0f);
+                        dir[dir_axis] = sign;
+                        rays.push_back(make_ray(origin, dir, kInf));
+                        // The unit cube's face along the direction: independent of the mesh.
+                        expected.push_back(sign > 0 ? 1.0f - origin[dir_axis] : origin[dir_axis]);
+                    }
+            }
+    REQUIRE(!rays.empty());
+    const Queries q = run_queries(cube, rays);
+    size_t wrong = 0;
+    for (size_t i = 0; i < rays.size(); ++i)
+        wrong += q.results[i].triangle < 0 || std::abs(q.results[i].t - expected[i]) > 1e-6f;
+    INFO(rays.size() << " rays, " << wrong << " missed or at the wrong distance");
+    CHECK(wrong == 0);
+}
+
+TEST_CASE("robustness: degenerate and zero-area triangles are never hit and give no NaN",
+          "[robustness]") {
+    Mesh mesh = grid_cube(2);
+    const size_t first_degenerate = mesh.size();
+    const glm::vec3 a(2.0f, 0.5f, 0.5f), b(3.0f, 0.5f, 0.5f), c(2.5f, 0.5f, 0.5f);
+    mesh.push_back({a, b, c});  // collinear
+    mesh.push_back({a, a, b});  // repeated vertex
+    mesh.push_back({c, c, c});  // a point
+    mesh.push_back({a, b, a});
+    std::vector<Ray> rays;
+    const glm::vec3 origins[] = {{2.5f, 2.0f, 0.5f}, {2.5f, 0.5f, -1.0f}, {1.5f, 0.5f, 0.5f},
+                                 {2.2f, 0.5f, 0.5f}};
+    for (const glm::vec3& o : origins)
+        for (const glm::vec3& target : {a, b, c, (a + b) * 0.5f}) {
+            if (o == target) continue;
+            rays.push_back(make_ray(o, target - o, kInf));
+            rays.push_back(make_ray(o, target - o, kInf, trax::layout::kRayAnyHit));
+        }
+    const Queries q = run_queries(mesh, rays);
+    for (size_t i = 0; i < rays.size(); ++i) {
+        const RayResult& r = q.results[i];
+        INFO("ray " << i);
+        CHECK(!std::isnan(r.t));
+        if (r.triangle >= 0) CHECK(q.scene_triangle(r.triangle) < first_degenerate);
+    }
+}
+
+TEST_CASE("robustness: NaN and infinite rays terminate without overflow, NaN rays hit nothing",
+          "[robustness]") {
+    const Mesh sphere = icosphere(2);
+    const glm::vec3 o(0.1f, 0.2f, 0.3f), d(0.3f, -0.5f, 0.8f);
+    std::vector<Ray> rays;
+    std::vector<bool> must_miss;
+    for (int axis = 0; axis < 3; ++axis)
+        for (float bad : {kNaN, kInf, -kInf}) {
+            glm::vec3 bad_o = o, bad_d = d;
+            bad_o[axis] = bad;
+            bad_d[axis] = bad;
+            rays.push_back(make_ray(bad_o, d, kInf));
+            rays.push_back(make_ray(o, bad_d, kInf));
+            rays.push_back(make_ray(bad_o, d, kInf, trax::layout::kRayAnyHit));
+            must_miss.insert(must_miss.end(), 3, std::isnan(bad));
+        }
+    for (float t_max : {kNaN, -kInf, -1.0f, 0.0f}) {
+        rays.push_back(make_ray(o, d, t_max));
+        must_miss.push_back(true);
+    }
+    rays.push_back(make_ray(o, glm::vec3(0.0f), kInf));  // no direction
+    must_miss.push_back(true);
+    rays.push_back(make_ray(glm::vec3(kNaN), glm::vec3(kNaN), kNaN));
+    must_miss.push_back(true);
+
+    const Queries q = run_queries(sphere, rays);  // finite instruction budget: no hang
+    for (size_t i = 0; i < rays.size(); ++i) {
+        const RayResult& r = q.results[i];
+        INFO("ray " << i);
+        CHECK(r.stack_overflows == 0);
+        CHECK(r.nodes_visited <= q.bvh.nodes.size());
+        if (must_miss[i]) CHECK(r.triangle == -1);
+        if (r.triangle >= 0) CHECK(std::isfinite(r.t));
+    }
+}
+
+TEST_CASE("robustness: rays leaving a surface never hit their own triangle", "[robustness]") {
+    const float scales[] = {1.0f, 1e-4f, 1e4f, 100.0f};
+    const glm::vec3 offsets[] = {glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f),
+                                 glm::vec3(1e5f, 1e5f, -1e5f)};
+    const glm::vec3 weights[] = {{1 / 3.f, 1 / 3.f, 1 / 3.f}, {0.98f, 0.01f, 0.01f},
+                                 {0.5f, 0.5f, 0.0f}, {1.0f, 0.0f, 0.0f}};
+    for (int k = 0; k < 4; ++k) {
+        // Shared vertices and edges included: a vertex (weight 1) lies on several triangles.
+        const Mesh mesh = transformed(icosphere(1), scales[k], offsets[k]);
+        const scene::Bvh bvh = bvh_for(mesh);
+        std::vector<int32_t> image_index(mesh.size());
+        for (size_t i = 0; i < bvh.triangle_order.size(); ++i) image_index[bvh.triangle_order[i]] = int32_t(i);
+        std::vector<Ray> rays;
+        std::vector<uint32_t> source;
+        for (uint32_t t = 0; t < mesh.size(); ++t) {
+            const scene::Triangle& tri = mesh[t];
+            const glm::vec3 n = glm::normalize(glm::cross(tri.v1 - tri.v0, tri.v2 - tri.v0));
+            for (const glm::vec3& w : weights) {
+                const glm::vec3 p = tri.v0 * w.x + tri.v1 * w.y + tri.v2 * w.z;
+                const glm::vec3 tangent = glm::normalize(tri.v1 - tri.v0);
+                // Outward to a light (a shadow ray, also at a grazing angle) and inward.
+                for (const glm::vec3& dir :
+                     {n * scales[k], (n * 0.05f + tangent) * scales[k], -n * scales[k]}) {
+                    const int mode = trax::layout::kRayFromSurface;
+                    rays.push_back(make_ray(p, dir, 1.0f, mode | trax::layout::kRayAnyHit, image_index[t]));
+                    rays.push_back(make_ray(p, dir * 4.0f, kInf, mode, image_index[t]));
+                    source.insert(source.end(), 2, t);
+                }
+            }
+        }
+        const Queries q = run_queries(mesh, rays);
+        size_t self_hits = 0, inward_misses = 0, outward_hits = 0;
+        for (size_t i = 0; i < rays.size(); ++i) {
+            const RayResult& r = q.results[i];
+            if (r.triangle >= 0 && q.scene_triangle(r.triangle) == source[i]) ++self_hits;
+            const bool inward = (i / 2) % 3 == 2, closest = i % 2 == 1;
+            if (inward && closest && r.triangle < 0) ++inward_misses;
+            // A convex mesh: nothing lies outside it, along the normal.
+            if ((i / 2) % 3 == 0 && r.triangle >= 0) ++outward_hits;
+        }
+        INFO("scale " << scales[k] << ": " << self_hits << " self hits, " << inward_misses
+                      << " inward misses, " << outward_hits << " outward hits of " << rays.size());
+        CHECK(self_hits == 0);
+        CHECK(inward_misses == 0);
+        CHECK(outward_hits == 0);
+    }
+}
