@@ -1,0 +1,204 @@
+// Validation of the chip model on real programs (programs/*.S, cross-compiled at build time)
+// executed by the functional machine: measured latencies and throughputs must equal the ones
+// the configuration implies. Latencies come from two builds of one program that differ only
+// by 64 extra dependent steps, so the cycle difference is 64 x the per-step latency.
+#include "sim/core/elf_loader.hpp"
+#include "timing/machine_source.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cstring>
+#include <memory>
+#include <string>
+
+using namespace tpsim;
+using namespace tpsim::timing;
+
+namespace {
+
+constexpr uint32_t kGlobalBase = 0x1000'0000;
+constexpr uint32_t kGlobalBytes = 1 << 20;
+
+/// One program run to completion on the chip, with its statistics registered.
+struct ProgramRun {
+    std::unique_ptr<core::Machine> machine;
+    std::unique_ptr<MachineSource> source;
+    std::unique_ptr<Chip> chip;
+    stats::Registry stats;
+
+    uint64_t stat(std::string_view name) const { return stats.at(name).integer(); }
+    uint64_t cycles() const { return chip->cycles(); }
+};
+
+/// Runs programs/<name>.elf; `fill_global` may set up global memory first.
+std::unique_ptr<ProgramRun> run_program(const std::string& name, const ChipConfig& config,
+                                        void (*fill_global)(uint8_t* global) = nullptr) {
+    core::MachineConfig machine_config = machine_config_for(config);
+    machine_config.global_bytes = kGlobalBytes;
+    auto run = std::make_unique<ProgramRun>();
+    run->machine = std::make_unique<core::Machine>(
+        core::load_elf(std::string(TPSIM_TIMING_PROGRAMS) + "/" + name + ".elf"), machine_config);
+    if (fill_global) fill_global(run->machine->memory().global().data());
+    run->source = std::make_unique<MachineSource>(*run->machine);
+    run->chip = std::make_unique<Chip>(config, *run->source);
+    run->chip->register_stats(run->stats);
+    run->chip->run(10'000'000);
+    return run;
+}
+
+void put_word(uint8_t* global, uint32_t addr, uint32_t value) {
+    std::memcpy(global + (addr - kGlobalBase), &value, 4);
+}
+
+ChipConfig tiny(uint32_t tps = 1) {
+    ChipConfig c = load_config(TPSIM_CONFIG_DIR "/tiny.toml");
+    c.chip.tps_per_tm = tps;
+    c.icache.threads_per_icache = tps;
+    return c;
+}
+
+/// Cycles of the 128-step build minus the 64-step build of `program`.
+uint64_t extra_cycles_for_64_steps(const std::string& program, const ChipConfig& c,
+                                   void (*fill_global)(uint8_t*) = nullptr) {
+    const uint64_t short_run = run_program(program + "_64", c, fill_global)->cycles();
+    const uint64_t long_run = run_program(program + "_128", c, fill_global)->cycles();
+    REQUIRE(long_run > short_run);
+    return long_run - short_run;
+}
+
+// Chains for chase.S. Word 0 holds the first address.
+constexpr uint32_t kChainBase = kGlobalBase + 0x1'0000;
+
+void self_loop(uint8_t* g) {  // one word pointing at itself: every load after the first hits L1
+    put_word(g, kGlobalBase, kChainBase);
+    put_word(g, kChainBase, kChainBase);
+}
+
+// A ring of 32 consecutive lines: 2 KiB, twice tiny's L1 (1 KiB, 2 ways x 8 sets, cycled in
+// LRU order: always a miss) and half its L2 (4 KiB, 4 ways x 16 sets: two lines per set, so
+// after the first lap always a hit).
+void l2_ring(uint8_t* g) {
+    put_word(g, kGlobalBase, kChainBase);
+    for (uint32_t i = 0; i < 32; ++i)
+        put_word(g, kChainBase + 64 * i, kChainBase + 64 * ((i + 1) % 32));
+}
+
+// 130 lines one DRAM row-interleave period apart (row_bytes x channels x banks = 1 KiB on
+// tiny): every load is a new line (L1 and L2 miss) in the same bank but another row (conflict).
+void dram_conflicts(uint8_t* g) {
+    const ChipConfig c = tiny();
+    const uint32_t stride = c.dram.row_bytes * c.dram.channels * c.dram.banks;
+    put_word(g, kGlobalBase, kChainBase);
+    for (uint32_t i = 0; i < 130; ++i) put_word(g, kChainBase + stride * i, kChainBase + stride * (i + 1));
+}
+
+}  // namespace
+
+TEST_CASE("pointer chase: L1-hit load-to-use latency is the LSU plus L1 hit latency",
+          "[validation]") {
+    for (auto [lsu, hit] : {std::pair{1u, 1u}, std::pair{2u, 3u}}) {
+        ChipConfig c = tiny();
+        c.fu.load_store.latency = lsu;
+        c.l1.hit_latency = hit;
+        CHECK(extra_cycles_for_64_steps("chase", c, self_loop) == 64 * (lsu + hit));
+    }
+}
+
+TEST_CASE("pointer chase: L2-hit latency adds the L2 hit latency and the L1 fill", "[validation]") {
+    for (uint32_t l2_hit : {4u, 9u}) {
+        ChipConfig c = tiny();
+        c.l2.hit_latency = l2_hit;
+        CHECK(extra_cycles_for_64_steps("chase", c, l2_ring) ==
+              64 * (c.fu.load_store.latency + 2 * c.l1.hit_latency + l2_hit));
+    }
+    const auto run = run_program("chase_128", tiny(), l2_ring);
+    CHECK(run->stat("tm0/l1/hits") == 0);
+    CHECK(run->stat("l2/0/misses") == 32 + 1);  // the first lap and word 0
+}
+
+TEST_CASE("pointer chase: DRAM row conflicts cost precharge, activate, CAS and burst",
+          "[validation]") {
+    const ChipConfig c = tiny();
+    const DramConfig& d = c.dram;
+    const uint64_t per_step = c.fu.load_store.latency + 2 * c.l1.hit_latency +
+                              2 * c.l2.hit_latency + d.tRP + d.tRCD + d.tCL + d.tBURST;
+    // The bank must be free to precharge when the next request arrives, or tRAS would add.
+    REQUIRE(per_step >= d.tRP + d.tRAS);
+    CHECK(extra_cycles_for_64_steps("chase", c, dram_conflicts) == 64 * per_step);
+    const auto short_run = run_program("chase_64", c, dram_conflicts);
+    const auto long_run = run_program("chase_128", c, dram_conflicts);
+    CHECK(long_run->stat("dram/row_conflicts") - short_run->stat("dram/row_conflicts") == 64);
+    CHECK(long_run->stat("dram/row_hits") == short_run->stat("dram/row_hits"));
+}
+
+TEST_CASE("dependency chains take each unit's configured latency per step", "[validation]") {
+    ChipConfig c = tiny();
+    c.fu.int_alu.latency = 1;
+    c.fu.int_muldiv.latency = 4;
+    c.fu.fp_add.latency = 3;
+    c.fu.fp_mul.latency = 5;
+    c.fu.fp_divsqrt.latency = 11;
+    c.fu.fp_misc.latency = 2;
+    const std::pair<const char*, uint32_t> chains[] = {
+        {"chain_add", 1}, {"chain_mul", 4},   {"chain_fadd", 3}, {"chain_fmul", 5},
+        {"chain_fdiv", 11}, {"chain_fsqrt", 11}, {"chain_fmin", 2}};
+    for (auto [program, latency] : chains) {
+        INFO(program);
+        CHECK(extra_cycles_for_64_steps(program, c) == 64 * latency);
+    }
+}
+
+TEST_CASE("N threads contending for K units get K operations per cycle", "[validation]") {
+    SECTION("pipelined: 8 threads, 2 FP multipliers") {
+        ChipConfig c = tiny(8);
+        c.icache.banks = 64;  // no fetch conflicts: the pool alone limits the rate
+        c.fu.fp_mul = {2, 2, true};
+        CHECK(extra_cycles_for_64_steps("independent_fmul", c) == 64 * 8 / 2);
+        CHECK(run_program("independent_fmul_64", c)->stat("tm0/fu/fp_mul/denied") > 0);
+    }
+    SECTION("not pipelined: 4 threads, 1 divider busy 16 cycles per operation") {
+        ChipConfig c = tiny(4);
+        c.icache.banks = 64;
+        c.fu.fp_divsqrt = {1, 16, false};
+        CHECK(extra_cycles_for_64_steps("independent_fdiv", c) == 64 * 4 * 16);
+    }
+    SECTION("not pipelined: 4 threads, 2 dividers") {
+        ChipConfig c = tiny(4);
+        c.icache.banks = 64;
+        c.fu.fp_divsqrt = {2, 16, false};
+        CHECK(extra_cycles_for_64_steps("independent_fdiv", c) == 64 * 4 * 16 / 2);
+    }
+}
+
+TEST_CASE("loads of one line merge in an MSHR; loads of one bank conflict", "[validation]") {
+    const ChipConfig c = tiny(4);  // 2 L1 banks, 2 load/store units
+    const auto merged = run_program("same_line", c);
+    CHECK(merged->stat("tm0/l1/reads") == 4);
+    CHECK(merged->stat("tm0/l1/misses") == 1);
+    CHECK(merged->stat("tm0/l1/merged_misses") == 3);
+    CHECK(merged->stat("dram/reads") == 1);
+
+    CHECK(run_program("same_bank", c)->stat("tm0/l1/bank_conflicts") > 0);
+    CHECK(run_program("next_lines", c)->stat("tm0/l1/bank_conflicts") == 0);
+}
+
+TEST_CASE("a streaming kernel saturates the DRAM bandwidth and no more", "[validation]") {
+    for (uint32_t channels : {1u, 2u}) {
+        ChipConfig c = tiny(8);
+        c.dram.channels = channels;
+        c.dram.row_bytes = 4096;
+        c.dram.queue_depth = 64;
+        c.l1.mshrs = 64;
+        c.l2.mshrs = 64;
+        c.l2.banks = 8;
+        const auto run = run_program("stream", c);
+        const double peak = double(channels) * c.l2.line_bytes /
+                            std::max(c.dram.tBURST, c.dram.tCCD);  // B/cycle
+        const double achieved = run->stats.value("chip/dram/bandwidth_bytes_per_cycle");
+        INFO("channels " << channels << ": " << achieved << " of " << peak << " B/cycle");
+        CHECK(run->stat("dram/bytes_read") == 2048 * 64);
+        CHECK(run->stat("dram/bus_busy_cycles") <= run->cycles() * channels);
+        CHECK(achieved <= peak);
+        CHECK(achieved >= 0.8 * peak);
+    }
+}
