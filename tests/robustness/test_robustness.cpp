@@ -389,3 +389,33 @@ TEST_CASE("robustness: rays leaving a surface never hit their own triangle", "[r
         CHECK(outward_hits == 0);
     }
 }
+
+TEST_CASE("robustness: a hit point on a large floor at y = 0 does not shadow itself",
+          "[robustness]") {
+    // The Cornell box's floor. A hit point p = o + t * d carries a rounding error of a few ulps
+    // of its LARGEST coordinate (~500, ulp 3e-5) in every component, so its y lands slightly
+    // above or below 0. The paper's absolute "near the origin" step (1/65536 = 1.5e-5) cannot
+    // lift a point 1e-4 below the floor; the scale-free offset must.
+    const glm::vec3 a(0.0f, 0.0f, 0.0f), b(556.0f, 0.0f, 0.0f), c(556.0f, 0.0f, 559.0f),
+                    d(0.0f, 0.0f, 559.0f);
+    const Mesh floor = {{a, b, c}, {a, c, d}};
+    const scene::Bvh bvh = bvh_for(floor);
+    const glm::vec3 light(278.0f, 548.0f, 279.5f);
+    std::vector<Ray> rays;
+    for (int i = 1; i < 20; ++i)
+        for (int j = 1; j < 20; ++j)
+            for (float error : {-2e-4f, -1e-4f, -3e-5f, 0.0f, 3e-5f, 1e-4f}) {
+                const glm::vec3 p(556.0f * float(i) / 20.0f, error, 559.0f * float(j) / 20.0f);
+                // Which of the two triangles p lies on: x > z * 556/559 is triangle a-b-c.
+                const uint32_t tri = p.x * 559.0f > p.z * 556.0f ? 0 : 1;
+                const int32_t image_tri = bvh.triangle_order[0] == tri ? 0 : 1;
+                rays.push_back(make_ray(p, light - p, 1.0f,
+                                        trax::layout::kRayFromSurface | trax::layout::kRayAnyHit,
+                                        image_tri));
+            }
+    const Queries q = run_queries(floor, rays);
+    size_t shadowed = 0;
+    for (const RayResult& r : q.results) shadowed += r.triangle >= 0;
+    INFO(shadowed << " of " << rays.size() << " floor points shadowed by the floor");
+    CHECK(shadowed == 0);
+}
