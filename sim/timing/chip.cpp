@@ -70,7 +70,10 @@ Chip::Chip(const ChipConfig& config, InstructionSource& source)
       dram_(config.dram, config.l2.line_bytes),
       global_registers_(config.global_registers) {
     validate(config_);
-    for (size_t op = 0; op < class_of_.size(); ++op) class_of_[op] = isa::info(isa::Op(op)).fu;
+    for (size_t op = 0; op < class_of_.size(); ++op) {
+        class_of_[op] = isa::info(isa::Op(op)).fu;
+        pool_of_[op] = pool_of(class_of_[op]);
+    }
     for (uint32_t t = 0; t < config.chip.num_tms; ++t) {
         tms_.push_back(std::make_unique<Tm>(config, t));
         tms_.back()->running = config.chip.tps_per_tm;
@@ -171,16 +174,14 @@ void Chip::tick_tm(Tm& tm, uint64_t now) {
     if (tm.running == 0) return;
 
     // Granted loads/stores take their L1 bank in rotating order.
-    for (uint32_t k = 0; k < n; ++k) {
-        const uint32_t i = (tm.rotation + k) % n;
+    for (uint32_t k = 0, i = tm.rotation; k < n; ++k, i = i + 1 == n ? 0 : i + 1) {
         Tm::Tp& tp = tm.tps[i];
         if (!tp.mem_waiting || tp.mem_at > now) continue;
         if (accepted(tm.l1.access(now, tp.mem_request))) tp.mem_waiting = false;
     }
 
     // Fetch, scoreboard check, FU request.
-    for (uint32_t k = 0; k < n; ++k) {
-        const uint32_t i = (tm.rotation + k) % n;
+    for (uint32_t k = 0, i = tm.rotation; k < n; ++k, i = i + 1 == n ? 0 : i + 1) {
         Tm::Tp& tp = tm.tps[i];
         if (tp.done) continue;
         ++tm.counters.active_tp_cycles;
@@ -196,7 +197,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now) {
             }
             tp.pending = source_.step(thread);
             tp.pending_class = class_of_[size_t(tp.pending.insn->op)];
-            tp.pending_pool = pool_of(tp.pending_class);
+            tp.pending_pool = pool_of_[size_t(tp.pending.insn->op)];
             tp.has_pending = true;
         }
         const isa::Decoded& d = *tp.pending.insn;
@@ -266,7 +267,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now) {
     uint64_t denied_after = 0;
     for (const FuPool& pool : tm.pools) denied_after += pool.counters().denied;
     tm.counters.stalls[size_t(Stall::FuBusy)] += denied_after - denied_before;
-    tm.rotation = (tm.rotation + 1) % n;
+    tm.rotation = tm.rotation + 1 == n ? 0 : tm.rotation + 1;
 }
 
 namespace {

@@ -66,7 +66,9 @@ private:
     uint32_t num_requesters_;
     uint32_t next_priority_ = 0;          // requester that wins first next time
     std::vector<uint32_t> pending_;
-    std::vector<uint64_t> unit_free_at_;  // per unit: first cycle it can start an operation
+    std::vector<uint64_t> unit_free_at_;  // per unit, if not pipelined: first cycle it can start
+    uint64_t starts_cycle_ = UINT64_MAX;  // if pipelined: operations started in cycle starts_cycle_
+    uint32_t starts_ = 0;
     Counters counters_;
 };
 

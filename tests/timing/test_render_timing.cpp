@@ -9,9 +9,11 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 
 using namespace tpsim;
@@ -92,5 +94,27 @@ TEST_CASE("timing parameters never change the image", "[render][invariance]") {
         CHECK(same_bits(result.rgb, reference.rgb));
         CHECK(result.timing->chip->cycles() != previous_cycles);  // the timing did change
         previous_cycles = result.timing->chip->cycles();
+    }
+}
+
+TEST_CASE("every key a cycle-level render registers is documented in docs/statistics.md",
+          "[render][docs]") {
+    std::ifstream doc(TPSIM_DOCS_DIR "/statistics.md");
+    REQUIRE(doc);
+    // Backticked keys containing '/' become regexes: <placeholder> matches one segment.
+    std::vector<std::regex> documented;
+    const std::regex quoted("`([A-Za-z0-9_<>.-]+/[A-Za-z0-9_<>/.-]+)`");
+    for (std::string line; std::getline(doc, line);)
+        for (std::sregex_iterator m(line.begin(), line.end(), quoted), end; m != end; ++m)
+            documented.emplace_back(
+                std::regex_replace((*m)[1].str(), std::regex("<[^>]+>"), "[^/]+"));
+    const auto result = render_cornell(render::Engine::timing, tiny());
+    stats::Registry registry;
+    render::register_stats(result, registry);
+    REQUIRE(registry.contains("chip/rays_per_second"));
+    for (const stats::Entry& e : registry.entries()) {
+        INFO(e.name);
+        CHECK(std::any_of(documented.begin(), documented.end(),
+                          [&](const std::regex& re) { return std::regex_match(e.name, re); }));
     }
 }
