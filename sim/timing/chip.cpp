@@ -30,6 +30,11 @@ struct Chip::Tm {
         bool has_pending = false;
         bool done = false;
         uint64_t fetch_at = 0;       // earliest cycle of the next fetch (branch bubbles)
+        // Operand waits are not re-checked every cycle: the TP sleeps until wake_at (kNever:
+        // until a memory or atomic reply for it arrives), its stall cycles counted in bulk.
+        uint64_t wake_at = 0;
+        uint64_t asleep_from = 0;    // first uncounted cycle of a kNever sleep
+        Pool asleep_on{};            // the producing pool the sleep is attributed to
         // A granted load/store waiting for its L1 access, from cycle mem_at.
         bool mem_waiting = false;
         uint64_t mem_at = 0;
@@ -50,6 +55,18 @@ struct Chip::Tm {
         : id(id), tps(c.chip.tps_per_tm), icache(c.icache, c.chip.tps_per_tm), l1(c.l1) {
         for (size_t p = 0; p < kPools; ++p)
             pools.emplace_back(pool_config(c.fu, Pool(p)), c.chip.tps_per_tm);
+    }
+
+    void add_operand_stalls(Pool blocking, uint64_t cycles) {
+        counters.active_tp_cycles += cycles;
+        counters.stalls[size_t(Stall::Operand)] += cycles;
+        counters.operand_stalls[size_t(blocking)] += cycles;
+    }
+    /// A reply for `tp` arrived: a TP asleep until then gets its stall cycles and runs again.
+    void wake(Tp& tp, uint64_t now) {
+        if (tp.wake_at != kNever) return;
+        add_operand_stalls(tp.asleep_on, now - tp.asleep_from);
+        tp.wake_at = now;
     }
 
     uint32_t id;
@@ -158,8 +175,10 @@ void Chip::tick_shared(uint64_t now) {
     global_registers_.tick(now);
     AtomicReply atomic;
     while (global_registers_.pop_reply(now, atomic)) {
-        Tm::Tp& tp = tms_[atomic.request.tm]->tps[atomic.request.tp];
+        Tm& tm = *tms_[atomic.request.tm];
+        Tm::Tp& tp = tm.tps[atomic.request.tp];
         tp.reg_ready[atomic.request.tag] = now;
+        tm.wake(tp, now);
         ++progress_;
     }
 }
@@ -168,7 +187,9 @@ void Chip::tick_tm(Tm& tm, uint64_t now) {
     const uint32_t n = static_cast<uint32_t>(tm.tps.size());
     MemReply reply;
     while (tm.l1.pop_reply(now, reply)) {
-        tm.tps[reply.request.source].reg_ready[reply.request.tag] = now;
+        Tm::Tp& tp = tm.tps[reply.request.source];
+        tp.reg_ready[reply.request.tag] = now;
+        tm.wake(tp, now);
         ++progress_;
     }
     if (tm.running == 0) return;
@@ -183,7 +204,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now) {
     // Fetch, scoreboard check, FU request.
     for (uint32_t k = 0, i = tm.rotation; k < n; ++k, i = i + 1 == n ? 0 : i + 1) {
         Tm::Tp& tp = tm.tps[i];
-        if (tp.done) continue;
+        if (tp.done || now < tp.wake_at) continue;
         ++tm.counters.active_tp_cycles;
         if (!tp.has_pending) {
             if (now < tp.fetch_at) {
@@ -211,6 +232,15 @@ void Chip::tick_tm(Tm& tm, uint64_t now) {
         if (operands_at > now) {
             ++tm.counters.stalls[size_t(Stall::Operand)];
             ++tm.counters.operand_stalls[size_t(blocking)];
+            // Nothing can change this wait before operands_at but a reply for this TP, which
+            // wakes it; so the cycles in between are operand stalls on `blocking`.
+            tp.wake_at = operands_at;
+            if (operands_at == kNever) {
+                tp.asleep_from = now + 1;
+                tp.asleep_on = blocking;
+            } else {
+                tm.add_operand_stalls(blocking, operands_at - now - 1);
+            }
             continue;
         }
         const Pool pool = tp.pending_pool;
