@@ -1,10 +1,12 @@
 #include <cstring>
+#include <random>
 
 #include <catch2/catch.hpp>
 #include <elf.h>
 
 #include "sim/core/elf_loader.hpp"
 #include "sim/core/error.hpp"
+#include "sim/core/machine.hpp"
 #include "test_support.hpp"
 
 using namespace tpsim;
@@ -196,4 +198,28 @@ TEST_CASE("the loader rejects patched headers with a message naming the problem"
         elf.set_phdr(elf.load(0), p);
         REQUIRE_THROWS_WITH(elf.parse(), Catch::Contains("file size"));
     }
+}
+
+TEST_CASE("randomly corrupted programs load and run or fail with an Error, never crash",
+          "[sim][elf]") {
+    const std::vector<uint8_t> good = read_bytes(guest_program("calls"));
+    std::mt19937 random(6958); // fixed seed: the same corruptions every run
+    std::uniform_int_distribution<size_t> header_byte(0, 255), any_byte(0, good.size() - 1);
+    std::uniform_int_distribution<int> value(0, 255), count(1, 4);
+    size_t loaded = 0, rejected = 0;
+    for (int trial = 0; trial < 400; ++trial) {
+        std::vector<uint8_t> bad = good;
+        // Half the trials hit the ELF and program headers, half anywhere (sections, DWARF).
+        for (int n = count(random); n > 0; --n)
+            bad[trial % 2 ? header_byte(random) : any_byte(random)] = uint8_t(value(random));
+        try {
+            Machine machine(load_elf(bad, "corrupt.elf"), {.max_instructions = 20000});
+            ++loaded;
+            machine.run();
+        } catch (const Error&) {
+            ++rejected;
+        }
+    }
+    CHECK(loaded > 0);
+    CHECK(rejected > 0);
 }
