@@ -169,11 +169,13 @@ Machine::Machine(Program program, const MachineConfig& config)
       memory_(program_,
               MemoryConfig{config.global_bytes, config.local_store_bytes, config.threads}) {
     config_.validate();
-    // Decode the span of all executable segments once; words in gaps between them decode as
-    // illegal and are reported as fetches outside the code.
+    // Decode the file-backed span of the executable segments once. Words in gaps between them
+    // decode as illegal and are reported as fetches outside the code; a zero-filled tail (memsz
+    // beyond filesz) is not decoded, so a huge bogus memsz costs nothing (see fetch_fault).
     uint32_t lo = UINT32_MAX, hi = 0;
     for (const Segment& s : program_.segments)
-        if (s.executable) lo = std::min(lo, s.vaddr), hi = std::max(hi, s.end());
+        if (s.executable)
+            lo = std::min(lo, s.vaddr), hi = std::max(hi, s.vaddr + uint32_t(s.bytes.size()));
     text_base_ = lo;
     text_bytes_ = (hi - lo) & ~3u;
     decoded_.reserve(text_bytes_ / 4);
@@ -206,7 +208,14 @@ void Machine::fault(uint32_t id, uint32_t pc, const GuestFault& what) {
 }
 
 void Machine::fetch_fault(uint32_t id, uint32_t pc) {
-    if (pc % 4 != 0 && pc - text_base_ < text_bytes_)
+    const Segment* segment = program_.segment_at(pc);
+    if (pc % 4 == 0 && segment && segment->executable) // the zero-filled tail of a code segment
+        fault(id, pc,
+              {FaultKind::IllegalInstruction,
+               "word 0x00000000 (zero fill past the end of the code) is not an RV32IMF "
+               "instruction",
+               "the pc ran off the end of the code; check the linker script"});
+    if (pc % 4 != 0 && segment && segment->executable)
         fault(id, pc,
               {FaultKind::Misaligned, "jump to a pc that is not 4-byte aligned",
                "a return address or function pointer is corrupt (stack smashed?)"});
