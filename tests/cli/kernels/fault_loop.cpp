@@ -1,0 +1,6 @@
+// Never finishes: only --max-instructions stops it.
+#include "trax.hpp"
+
+void trax_main() {
+    for (;;) asm volatile("");
+}
