@@ -1,8 +1,14 @@
 #include "native_twin.hpp"
 
 #include <dlfcn.h>
+#include <signal.h>
+#include <sys/mman.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
-#include <array>
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <memory>
 
 #include <fmt/format.h>
@@ -11,6 +17,44 @@
 #include "sim/core/error.hpp"
 
 namespace tpsim::render {
+namespace {
+
+constexpr size_t kErrorBytes = 1024;
+
+/// Memory shared with the child process that runs the twin; unmapped when it goes.
+class SharedMapping {
+public:
+    explicit SharedMapping(size_t bytes)
+        : bytes_(std::max<size_t>(bytes, 1)),
+          data_(mmap(nullptr, bytes_, PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0)) {
+        if (data_ == MAP_FAILED)
+            throw Error(fmt::format("cannot map {} bytes for the native twin: {}", bytes_,
+                                    std::strerror(errno)));
+    }
+    ~SharedMapping() { munmap(data_, bytes_); }
+    SharedMapping(const SharedMapping&) = delete;
+    SharedMapping& operator=(const SharedMapping&) = delete;
+    void* data() const { return data_; }
+
+private:
+    size_t bytes_;
+    void* data_;
+};
+
+std::string describe_signal(int signal) {
+    switch (signal) {
+        case SIGSEGV:
+            return "SIGSEGV: an invalid memory access (null or wild pointer, or a stack overflow "
+                   "from deep recursion)";
+        case SIGBUS: return "SIGBUS: a misaligned or invalid memory access";
+        case SIGFPE: return "SIGFPE: an integer division by zero";
+        case SIGILL: return "SIGILL: an illegal instruction";
+        case SIGABRT: return "SIGABRT: the kernel aborted";
+        default: return fmt::format("signal {} ({})", signal, strsignal(signal));
+    }
+}
+
+}  // namespace
 
 std::filesystem::path native_twin_of(const std::filesystem::path& kernel_elf) {
     return kernel_elf.parent_path() / ("lib" + kernel_elf.stem().string() + "_native.so");
@@ -29,12 +73,36 @@ void run_native_twin(const std::filesystem::path& library, std::vector<uint32_t>
     if (run == nullptr)
         throw Error(fmt::format("'{}' is not a tpsim native twin (no {} symbol)", library.string(),
                                 TPSIM_NATIVE_RUN_SYMBOL));
-    std::array<char, 1024> error{};
-    const TraxNativeContext context{global_words.data(), uint32_t(global_words.size()),
-                                    num_threads,         num_tms,
-                                    tm_size,             error.data(),
-                                    uint32_t(error.size())};
-    if (run(&context) != 0) throw Error(error.data());
+
+    // The twin is the student's code running on the host: a wild pointer or runaway recursion
+    // there is a real SIGSEGV. It runs in a child process over shared memory so that such a
+    // crash becomes an error message here instead of killing tpsim.
+    const size_t image_bytes = global_words.size() * sizeof(uint32_t);
+    SharedMapping shared(kErrorBytes + image_bytes);
+    char* const error = static_cast<char*>(shared.data());
+    uint32_t* const words = reinterpret_cast<uint32_t*>(error + kErrorBytes);
+    std::memcpy(words, global_words.data(), image_bytes);
+    const TraxNativeContext context{words,       uint32_t(global_words.size()), num_threads,
+                                    num_tms,     tm_size,                       error,
+                                    kErrorBytes};
+    const pid_t child = fork();
+    if (child < 0) throw Error(fmt::format("cannot start the native twin: fork failed: {}",
+                                           std::strerror(errno)));
+    if (child == 0) _exit(run(&context) == 0 ? 0 : 1);
+
+    int status = 0;
+    while (waitpid(child, &status, 0) < 0)
+        if (errno != EINTR)
+            throw Error(fmt::format("lost the native twin's process: {}", std::strerror(errno)));
+    if (WIFSIGNALED(status))
+        throw Error(fmt::format(
+            "the native twin '{}' crashed with {}; run without --native to have the simulator "
+            "name the thread, pc and source line, or debug the twin with gdb",
+            library.filename().string(), describe_signal(WTERMSIG(status))));
+    if (WEXITSTATUS(status) != 0)
+        throw Error(error[0] != '\0' ? std::string(error, strnlen(error, kErrorBytes))
+                                     : "the native twin failed without saying why");
+    std::memcpy(global_words.data(), words, image_bytes);
 }
 
 }  // namespace tpsim::render
