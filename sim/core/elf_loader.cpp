@@ -2,12 +2,15 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <map>
 #include <memory>
 
+#include <cxxabi.h>
 #include <elf.h>
 #include <elfutils/libdw.h>
 #include <fmt/format.h>
@@ -22,6 +25,15 @@ namespace {
 
 constexpr const char* kBuildHint =
     "build it with clang --target=riscv32-unknown-elf -march=rv32imf -mabi=ilp32f";
+
+/// A C++ symbol as the student wrote it ("(anonymous namespace)::depth(int)"), or the name
+/// itself when it is not a mangled C++ name.
+std::string demangle(const std::string& name) {
+    int status = 0;
+    const std::unique_ptr<char, void (*)(void*)> plain(
+        abi::__cxa_demangle(name.c_str(), nullptr, nullptr, &status), std::free);
+    return status == 0 && plain ? std::string(plain.get()) : name;
+}
 
 [[noreturn]] void reject(const std::string& name, const std::string& problem) {
     throw Error(fmt::format("cannot load '{}': {}", name, problem));
@@ -258,7 +270,8 @@ const Symbol* Program::function_at(uint32_t pc) const {
 std::string Program::describe_pc(uint32_t pc) const {
     const Symbol* s = function_at(pc);
     if (!s) return "";
-    return pc == s->address ? s->name : fmt::format("{}+{:#x}", s->name, pc - s->address);
+    const std::string name = demangle(s->name);
+    return pc == s->address ? name : fmt::format("{}+{:#x}", name, pc - s->address);
 }
 
 std::optional<SourceLocation> Program::source_at(uint32_t pc) const {
@@ -306,6 +319,10 @@ Program load_elf(std::span<const uint8_t> image, const std::string& name) {
 }
 
 Program load_elf(const std::string& path) {
+    // Reading a directory through an ifstream throws an unhelpful std::ios_base::failure.
+    if (std::error_code ec; std::filesystem::is_directory(path, ec))
+        throw Error(fmt::format("cannot load '{}': it is a directory; give the path of an ELF file",
+                                path));
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(fmt::format("cannot open '{}': no such file or not readable", path));
     std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)),
