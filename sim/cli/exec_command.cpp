@@ -24,7 +24,7 @@ Command add_exec_command(CLI::App& app) {
     command->add_option("--max-instructions", options->machine.max_instructions,
                         "Instructions a thread may run before it is stopped as a runaway")
         ->capture_default_str()
-        ->check(CLI::PositiveNumber);
+        ->check(kPositiveCount);
     command->add_option("--local-store", options->machine.local_store_bytes,
                         "Bytes of per-thread local store (stack); multiple of 16 in [256, 1048576]")
         ->capture_default_str();

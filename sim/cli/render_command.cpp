@@ -168,7 +168,7 @@ Command add_render_command(CLI::App& app) {
                         "beside it (PATH with extension .config.toml)");
     command->add_option("--max-instructions", o->max_instructions,
                         "Instructions a thread may run before it is stopped as a runaway")
-        ->check(CLI::PositiveNumber)
+        ->check(kPositiveCount)
         ->capture_default_str();
     return {command, [o] { return run_render(*o); }};
 }

@@ -1,6 +1,7 @@
 #include "config.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <toml++/toml.h>
 
 #include <bit>
@@ -27,7 +28,8 @@ void for_each_field(Config& c, Visit&& visit) {
     visit("chip.tms_per_l2", c.chip.tms_per_l2, Range{1, 4096});
     visit("tp.branch_taken_penalty", c.tp.branch_taken_penalty, Range{0, 1000});
     visit("tp.branch_not_taken_penalty", c.tp.branch_not_taken_penalty, Range{0, 1000});
-    visit("tp.local_store_bytes", c.tp.local_store_bytes, Range{64, 1u << 24});
+    // The functional machine's limits (sim/core/memory.cpp), so a bad size is reported here.
+    visit("tp.local_store_bytes", c.tp.local_store_bytes, Range{256, 1u << 20});
     visit("tp.local_store_latency", c.tp.local_store_latency, Range{1, kMaxLatency});
     auto pool = [&](std::string_view name, auto& fu) {
         visit(fmt::format("fu.{}.count", name), fu.count, Range{1, 1024});
@@ -108,9 +110,23 @@ bool assign(ChipConfig& config, std::string_view key, std::optional<bool> as_boo
     return found;
 }
 
+/// The error for a key no field has, listing the valid keys of its section (or the sections).
 [[noreturn]] void unknown_key(std::string_view where, std::string_view key) {
-    throw ConfigError(fmt::format(
-        "{}: unknown key '{}'; run with --print-config to list the valid keys", where, key));
+    const std::string_view section = key.substr(0, key.rfind('.') + 1);  // "l1." or ""
+    std::vector<std::string> keys, sections;
+    ChipConfig defaults;
+    for_each_field(defaults, [&](std::string_view name, auto&, Range) {
+        const std::string_view head = name.substr(0, name.rfind('.'));
+        if (sections.empty() || sections.back() != head) sections.emplace_back(head);
+        if (!section.empty() && name.starts_with(section))
+            keys.emplace_back(name.substr(section.size()));
+    });
+    throw ConfigError(
+        keys.empty()
+            ? fmt::format("{}: unknown key '{}'; the sections are {}", where, key,
+                          fmt::join(sections, ", "))
+            : fmt::format("{}: unknown key '{}'; valid keys in [{}] are {}", where, key,
+                          section.substr(0, section.size() - 1), fmt::join(keys, ", ")));
 }
 
 void load_table(ChipConfig& config, const toml::table& table, const std::string& prefix,
