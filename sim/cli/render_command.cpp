@@ -104,12 +104,24 @@ int run_render(const RenderCommandOptions& o) {
     options.bvh.builder = o.bvh == "binned" ? scene::BvhBuilder::binned : scene::BvhBuilder::sweep;
     options.bvh.max_leaf_size = o.max_leaf;
 
+    // Bad output paths are found now, not after a render that may take hours.
+    const std::filesystem::path output =
+        o.output.empty() ? std::filesystem::path(o.scene).stem().string() + ".png" : o.output;
+    render::check_image_path(output);
+    if (!o.stats_json.empty()) {
+        const std::filesystem::path json_directory =
+            std::filesystem::path(o.stats_json).has_parent_path()
+                ? std::filesystem::path(o.stats_json).parent_path()
+                : std::filesystem::path(".");
+        if (std::error_code ec; !std::filesystem::is_directory(json_directory, ec))
+            throw Error(fmt::format("cannot write statistics to '{}': directory '{}' does not exist",
+                                    o.stats_json, json_directory.string()));
+    }
+
     ProgressLine progress_line;
     options.on_progress = [&](const render::Progress& p) { progress_line.update(p); };
     const render::RenderResult result = render::render(options);
     progress_line.clear();
-    const std::filesystem::path output =
-        o.output.empty() ? std::filesystem::path(o.scene).stem().string() + ".png" : o.output;
     render::write_image(output, result.rgb, result.scene.width, result.scene.height);
 
     fmt::print("# chip configuration (resolved)\n{}\n", timing::to_toml(options.chip));

@@ -32,6 +32,23 @@ uint8_t encode_srgb(float linear) {
 
 }  // namespace
 
+void check_image_path(const std::filesystem::path& path) {
+    if (!OIIO::ImageOutput::create(path.string())) {
+        OIIO::geterror();  // consumed here: the message below says it better
+        throw Error(fmt::format("cannot write image '{}': {}; use .png, .exr, .tif, .ppm ...",
+                                path.string(),
+                                path.has_extension()
+                                    ? fmt::format("no image format has the extension '{}'",
+                                                  path.extension().string())
+                                    : std::string("the name has no image extension")));
+    }
+    const std::filesystem::path directory =
+        path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+    if (std::error_code ec; !std::filesystem::is_directory(directory, ec))
+        throw Error(fmt::format("cannot write image '{}': directory '{}' does not exist",
+                                path.string(), directory.string()));
+}
+
 void write_image(const std::filesystem::path& path, std::span<const float> rgb, uint32_t width,
                  uint32_t height) {
     auto out = OIIO::ImageOutput::create(path.string());
@@ -42,6 +59,9 @@ void write_image(const std::filesystem::path& path, std::span<const float> rgb, 
     OIIO::ImageSpec spec(int(width), int(height), 3, linear ? OIIO::TypeDesc::FLOAT
                                                             : OIIO::TypeDesc::UINT8);
     spec.attribute("oiio:ColorSpace", linear ? "linear" : "sRGB");
+    // OpenImageIO stamps TIFF and EXR files with the current time unless DateTime is given;
+    // empty leaves it out, so the same render gives the same bytes.
+    spec.attribute("DateTime", "");
     bool ok = out->open(path.string(), spec);
     if (ok && linear) {
         ok = out->write_image(OIIO::TypeDesc::FLOAT, rgb.data());

@@ -13,6 +13,10 @@ namespace tpsim::render {
 void write_image(const std::filesystem::path& path, std::span<const float> rgb, uint32_t width,
                  uint32_t height);
 
+/// Throws tpsim::Error unless an image could be written at `path`: a known image extension and
+/// an existing directory. Called before a render so a long run cannot end in a bad path.
+void check_image_path(const std::filesystem::path& path);
+
 /// Reads an image back as RGB floats exactly as stored (for tests and comparisons).
 std::vector<float> read_image(const std::filesystem::path& path, uint32_t& width, uint32_t& height);
 
