@@ -61,8 +61,8 @@ template <bool kRecord> class ThreadEnv {
         const Machine& m = machine_;
         const uint32_t per_tm = m.config_.threads_per_tm;
         // Functionally every instruction takes one cycle, so cycle = instret; the timing model
-        // supplies real cycles. (instret itself is the hart's.)
-        const uint64_t cycles = h_.instret;
+        // supplies real cycles (set_cycle_counter). (instret itself is the hart's.)
+        const uint64_t cycles = m.cycle_counter_ ? *m.cycle_counter_ : h_.instret;
         switch (csr) {
         case c::kMhartid:
             value = id_;
@@ -234,11 +234,10 @@ void Machine::limit_fault(uint32_t id) {
            "raise it with --max-instructions, or look for an endless loop"});
 }
 
-template <bool kRecord>
-void Machine::run_quantum(uint32_t id, uint64_t budget, StepRecord* record) {
+void Machine::run_quantum(uint32_t id, uint64_t budget) {
     Thread& t = threads_[id];
     isa::Hart& h = t.hart;
-    ThreadEnv<kRecord> env(*this, id);
+    ThreadEnv<false> env(*this, id);
     uint64_t* per_op = counters_.per_op.data();
     const isa::Decoded* decoded = decoded_.data();
     // Locals, not members: stores through the hart's registers could alias members, and the
@@ -261,11 +260,6 @@ void Machine::run_quantum(uint32_t id, uint64_t budget, StepRecord* record) {
             const isa::Decoded& d = decoded[index];
             ++per_op[size_t(d.op)];
             isa::execute(d, h, env);
-            if constexpr (kRecord) {
-                const AccessRecorder a = env.access();
-                const bool exited = env.exited();
-                *record = {pc, &d, a.address, a.bytes, a.store, !exited && h.pc != pc + 4, exited};
-            }
         }
     } catch (const GuestFault& f) {
         t.executed += done;
@@ -286,23 +280,49 @@ void Machine::run() {
             Thread& t = threads_[id];
             const uint64_t left = config_.max_instructions - t.executed;
             if (left == 0) limit_fault(id);
-            run_quantum<false>(id, std::min<uint64_t>(left, config_.quantum), nullptr);
+            run_quantum(id, std::min<uint64_t>(left, config_.quantum));
             if (t.state == ThreadState::Running) running[kept++] = id;
         }
         running.resize(kept);
     }
 }
 
-StepRecord Machine::step(uint32_t id) {
-    Thread& t = threads_.at(id);
-    if (t.state != ThreadState::Running)
+void Machine::refuse_step(uint32_t id) {
+    if (id >= thread_count())
+        throw Error(fmt::format("step(): there is no thread {} (the machine has {})", id,
+                                thread_count()));
+    if (threads_[id].state != ThreadState::Running)
         throw Error(fmt::format("step(): thread {} is not running; the timing model must stop "
                                 "issuing from exited threads",
                                 id));
-    if (t.executed == config_.max_instructions) limit_fault(id);
-    StepRecord record;
-    run_quantum<true>(id, 1, &record);
-    return record;
+    limit_fault(id);
+}
+
+// The timing model's hot path (once per simulated instruction): every check in one unlikely
+// branch, the environment built inline, the fault paths out of line.
+StepRecord Machine::step(uint32_t id) {
+    if (id >= threads_.size() || threads_[id].state != ThreadState::Running ||
+        threads_[id].executed == config_.max_instructions) [[unlikely]]
+        refuse_step(id);
+    Thread& t = threads_[id];
+    isa::Hart& h = t.hart;
+    const uint32_t pc = h.pc;
+    const uint32_t index = std::rotr(pc - text_base_, 2); // range and alignment, as in run_quantum
+    if (index >= text_bytes_ / 4) [[unlikely]]
+        fetch_fault(id, pc);
+    const isa::Decoded& d = decoded_[index];
+    ++counters_.per_op[size_t(d.op)];
+    ThreadEnv<true> env(*this, id);
+    try {
+        isa::execute(d, h, env);
+    } catch (const GuestFault& f) {
+        fault(id, pc, f);
+    }
+    ++t.executed;
+    ++counters_.instructions;
+    const AccessRecorder a = env.access();
+    const bool exited = env.exited();
+    return {pc, &d, a.address, a.bytes, a.store, !exited && h.pc != pc + 4, exited};
 }
 
 } // namespace tpsim::core

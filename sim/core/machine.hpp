@@ -75,6 +75,11 @@ class Machine {
     /// Executes one instruction of a running thread and reports what it did. Throws Fault.
     StepRecord step(uint32_t thread);
 
+    /// Timing mode: the cycle/time CSRs read `*cycles` (the chip's current cycle) instead of
+    /// instret; nullptr (the default) = functional mode, where cycle = instret. The counter
+    /// must outlive the instructions that read it.
+    void set_cycle_counter(const uint64_t* cycles) { cycle_counter_ = cycles; }
+
     const Program& program() const { return program_; }
     const MachineConfig& config() const { return config_; }
     Memory& memory() { return memory_; }
@@ -88,10 +93,11 @@ class Machine {
   private:
     template <bool kRecord> friend class ThreadEnv;
 
-    template <bool kRecord> void run_quantum(uint32_t id, uint64_t budget, StepRecord* record);
+    void run_quantum(uint32_t id, uint64_t budget);
     [[noreturn]] void fault(uint32_t id, uint32_t pc, const GuestFault& what);
     [[noreturn]] void fetch_fault(uint32_t id, uint32_t pc);
     [[noreturn]] void limit_fault(uint32_t id);
+    [[noreturn]] void refuse_step(uint32_t id);
     uint32_t read_only_csr(uint32_t id, uint32_t csr, bool& known) const;
 
     Program program_;
@@ -103,6 +109,7 @@ class Machine {
     std::vector<Thread> threads_;
     std::array<uint32_t, kGlobalRegisters> global_registers_{};
     Counters counters_;
+    const uint64_t* cycle_counter_ = nullptr;
 };
 
 } // namespace tpsim::core

@@ -1,6 +1,7 @@
 #include "chip.hpp"
 
 #include "kernel/memory_map.hpp"
+#include "timing/machine_source.hpp"
 
 #include <fmt/format.h>
 
@@ -22,7 +23,9 @@ bool is_local(uint32_t addr) { return addr >= trax::map::kLocalTop - trax::map::
 
 struct Chip::Tm {
     struct Tp {
-        std::array<uint64_t, isa::kNumRegs> reg_ready{};  // cycle each register becomes readable
+        // Cycle each register becomes readable; the extra last slot stands for kNoReg (an
+        // unused operand) and stays 0, so the scoreboard check needs no branch per operand.
+        std::array<uint64_t, isa::kNumRegs + 1> reg_ready{};
         std::array<Pool, isa::kNumRegs> reg_producer{};   // pool that will write it
         StepInfo pending;            // fetched, not yet issued
         isa::FuClass pending_class{};
@@ -78,6 +81,7 @@ struct Chip::Tm {
     uint32_t atomic_sequence = 0;
     std::vector<AtomicRequest> atomics_out;  // sent this cycle, collected by the chip
     uint32_t running = 0;
+    uint32_t mem_waiting = 0;     // TPs with mem_waiting set
     Counters counters;
 };
 
@@ -96,11 +100,25 @@ Chip::Chip(const ChipConfig& config, InstructionSource& source)
         tms_.back()->running = config.chip.tps_per_tm;
     }
     for (uint32_t g = 0; g < config.num_l2(); ++g) l2s_.emplace_back(config.l2);
+    // The machine's cycle CSRs read this chip's clock. During the tick of cycle `now`,
+    // cycles_ == now, so an instruction sees the cycle it is fetched (and executed) in.
+    if (auto* machine = dynamic_cast<MachineSource*>(&source_))
+        machine->machine().set_cycle_counter(&cycles_);
 }
 
-Chip::~Chip() = default;
+Chip::~Chip() {
+    if (auto* machine = dynamic_cast<MachineSource*>(&source_))
+        machine->machine().set_cycle_counter(nullptr);
+}
 
 uint64_t Chip::run(uint64_t max_cycles, const ProgressHook& on_progress) {
+    if (auto* machine = dynamic_cast<MachineSource*>(&source_))
+        return run_with(*machine, max_cycles, on_progress);
+    return run_with(source_, max_cycles, on_progress);
+}
+
+template <class Source>
+uint64_t Chip::run_with(Source& source, uint64_t max_cycles, const ProgressHook& on_progress) {
     uint64_t last_progress = 0, last_progress_cycle = 0;
     auto busy = [&] {
         for (const auto& tm : tms_)
@@ -116,7 +134,7 @@ uint64_t Chip::run(uint64_t max_cycles, const ProgressHook& on_progress) {
                 "timing: the chip did not finish within {} cycles; raise the cycle limit",
                 max_cycles));
         tick_shared(now);
-        for (auto& tm : tms_) tick_tm(*tm, now);
+        for (auto& tm : tms_) tick_tm(*tm, now, source);
         cycles_ = now + 1;
         if (on_progress && cycles_ % kProgressInterval == 0) on_progress(cycles_);
         if (progress_ != last_progress) {
@@ -183,7 +201,8 @@ void Chip::tick_shared(uint64_t now) {
     }
 }
 
-void Chip::tick_tm(Tm& tm, uint64_t now) {
+template <class Source>
+void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
     const uint32_t n = static_cast<uint32_t>(tm.tps.size());
     MemReply reply;
     while (tm.l1.pop_reply(now, reply)) {
@@ -195,10 +214,14 @@ void Chip::tick_tm(Tm& tm, uint64_t now) {
     if (tm.running == 0) return;
 
     // Granted loads/stores take their L1 bank in rotating order.
-    for (uint32_t k = 0, i = tm.rotation; k < n; ++k, i = i + 1 == n ? 0 : i + 1) {
+    for (uint32_t k = 0, i = tm.rotation; tm.mem_waiting != 0 && k < n;
+         ++k, i = i + 1 == n ? 0 : i + 1) {
         Tm::Tp& tp = tm.tps[i];
         if (!tp.mem_waiting || tp.mem_at > now) continue;
-        if (accepted(tm.l1.access(now, tp.mem_request))) tp.mem_waiting = false;
+        if (accepted(tm.l1.access(now, tp.mem_request))) {
+            tp.mem_waiting = false;
+            --tm.mem_waiting;
+        }
     }
 
     // Fetch, scoreboard check, FU request.
@@ -212,24 +235,27 @@ void Chip::tick_tm(Tm& tm, uint64_t now) {
                 continue;
             }
             const uint32_t thread = tm.id * n + i;
-            if (!tm.icache.fetch(now, i, source_.next_pc(thread))) {
+            if (!tm.icache.fetch(now, i, source.next_pc(thread))) {
                 ++tm.counters.stalls[size_t(Stall::FetchConflict)];
                 continue;
             }
-            tp.pending = source_.step(thread);
+            tp.pending = source.step(thread);
             tp.pending_class = class_of_[size_t(tp.pending.insn->op)];
             tp.pending_pool = pool_of_[size_t(tp.pending.insn->op)];
             tp.has_pending = true;
         }
         const isa::Decoded& d = *tp.pending.insn;
-        uint64_t operands_at = 0;
-        Pool blocking = Pool::IntAlu;
-        for (uint8_t r : {d.rs1, d.rs2, d.rs3, d.rd}) {  // rd too: no write-after-write reorder
-            if (r == isa::kNoReg || tp.reg_ready[r] <= operands_at) continue;
-            operands_at = tp.reg_ready[r];
-            blocking = tp.reg_producer[r];
-        }
+        // rd too: no write-after-write reorder. kNoReg maps to the always-ready last slot.
+        const auto ready_at = [&](uint8_t r) { return tp.reg_ready[std::min(r, isa::kNumRegs)]; };
+        const uint64_t operands_at =
+            std::max(std::max(ready_at(d.rs1), ready_at(d.rs2)), std::max(ready_at(d.rs3), ready_at(d.rd)));
         if (operands_at > now) {
+            Pool blocking = Pool::IntAlu;  // producer of the first operand that is ready last
+            for (uint8_t r : {d.rs1, d.rs2, d.rs3, d.rd})
+                if (r != isa::kNoReg && tp.reg_ready[r] == operands_at) {
+                    blocking = tp.reg_producer[r];
+                    break;
+                }
             ++tm.counters.stalls[size_t(Stall::Operand)];
             ++tm.counters.operand_stalls[size_t(blocking)];
             // Nothing can change this wait before operands_at but a reply for this TP, which
@@ -252,11 +278,9 @@ void Chip::tick_tm(Tm& tm, uint64_t now) {
     }
 
     // Requests the pools refuse are the FU-busy stalls (the TP keeps its instruction).
-    uint64_t denied_before = 0;
-    for (const FuPool& pool : tm.pools) denied_before += pool.counters().denied;
     for (size_t p = 0; p < kPools; ++p) {
         const Pool pool = Pool(p);
-        tm.pools[p].arbitrate(now, [&](uint32_t i, uint64_t ready) {
+        tm.counters.stalls[size_t(Stall::FuBusy)] += tm.pools[p].arbitrate(now, [&](uint32_t i, uint64_t ready) {
             Tm::Tp& tp = tm.tps[i];
             const StepInfo& s = tp.pending;
             const isa::Decoded& d = *s.insn;
@@ -274,6 +298,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now) {
                 result_at = ready + config_.tp.local_store_latency;
             } else if (s.mem_bytes != 0) {
                 tp.mem_waiting = true;
+                ++tm.mem_waiting;
                 tp.mem_at = ready;
                 tp.mem_request = {s.mem_address, i, d.rd, s.mem_store};
                 result_at = kNever;  // set by the L1 reply
@@ -294,9 +319,6 @@ void Chip::tick_tm(Tm& tm, uint64_t now) {
             }
         });
     }
-    uint64_t denied_after = 0;
-    for (const FuPool& pool : tm.pools) denied_after += pool.counters().denied;
-    tm.counters.stalls[size_t(Stall::FuBusy)] += denied_after - denied_before;
     tm.rotation = tm.rotation + 1 == n ? 0 : tm.rotation + 1;
 }
 

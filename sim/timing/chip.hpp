@@ -78,8 +78,13 @@ public:
 
 private:
     struct Tm;
+    // The cycle loop is instantiated for the concrete MachineSource (its calls inline) and for
+    // any other InstructionSource (tests' scripted sources).
+    template <class Source>
+    uint64_t run_with(Source& source, uint64_t max_cycles, const ProgressHook& on_progress);
     void tick_shared(uint64_t now);
-    void tick_tm(Tm& tm, uint64_t now);
+    template <class Source>
+    void tick_tm(Tm& tm, uint64_t now, Source& source);
 
     ChipConfig config_;
     InstructionSource& source_;

@@ -45,24 +45,10 @@ const FuConfig& pool_config(const FuPoolsConfig& p, Pool pool) {
 }
 
 FuPool::FuPool(const FuConfig& config, uint32_t num_requesters)
-    : config_(config), num_requesters_(num_requesters), unit_free_at_(config.count, 0) {
+    : config_(config), num_requesters_(num_requesters),
+      requested_((size_t{num_requesters} + 63) / 64, 0), unit_free_at_(config.count, 0) {
     if (num_requesters == 0 || config.count == 0)
         throw std::invalid_argument("FuPool: needs at least one requester and one unit");
-    pending_.reserve(num_requesters);
-}
-
-void FuPool::order_by_priority() {
-    // Distance from the rotating priority pointer; ids are unique, so the order is total.
-    auto distance = [this](uint32_t id) {  // (id - next_priority_) mod n, without a division
-        return id >= next_priority_ ? id - next_priority_ : id + num_requesters_ - next_priority_;
-    };
-    // Callers usually request in some rotated id order; then rotating the list to its nearest
-    // requester sorts it in linear time. Otherwise, sort.
-    auto by_distance = [&](uint32_t a, uint32_t b) { return distance(a) < distance(b); };
-    std::rotate(pending_.begin(), std::min_element(pending_.begin(), pending_.end(), by_distance),
-                pending_.end());
-    if (!std::is_sorted(pending_.begin(), pending_.end(), by_distance))
-        std::sort(pending_.begin(), pending_.end(), by_distance);
 }
 
 bool FuPool::try_start(uint64_t now) {

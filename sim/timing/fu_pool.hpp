@@ -6,6 +6,8 @@
 #include "stats/registry.hpp"
 #include "timing/config.hpp"
 
+#include <algorithm>
+#include <bit>
 #include <cstdint>
 #include <string_view>
 #include <vector>
@@ -31,26 +33,45 @@ public:
     FuPool(const FuConfig& config, uint32_t num_requesters);
 
     /// Requester `id` wants a unit this cycle. Call before arbitrate(), at most once per id.
-    void request(uint32_t id) { pending_.push_back(id); }
+    void request(uint32_t id) {
+        requested_[id >> 6] |= uint64_t{1} << (id & 63);
+        ++requests_;
+    }
 
     /// Grants free units to this cycle's requests in rotating-priority order, calling
     /// on_grant(id, ready_cycle) for each winner (ready_cycle = when its result can be read);
-    /// the others are counted as denied and should request again next cycle.
+    /// the others are counted as denied and should request again next cycle. Returns how many
+    /// were denied.
     template <class OnGrant>
-    void arbitrate(uint64_t now, OnGrant&& on_grant) {
-        if (pending_.empty()) return;
-        if (pending_.size() > 1) order_by_priority();
+    uint32_t arbitrate(uint64_t now, OnGrant&& on_grant) {
+        if (requests_ == 0) return 0;
+        // Requests are a bit set, walked from the priority pointer with wrap-around: the
+        // rotating-priority order without sorting.
+        const uint32_t words = static_cast<uint32_t>(requested_.size());
+        const uint32_t first_word = next_priority_ >> 6;
+        const uint64_t below_start = (uint64_t{1} << (next_priority_ & 63)) - 1;
         uint32_t last_granted = kNone;
-        for (uint32_t id : pending_) {
-            if (!try_start(now)) {
-                ++counters_.denied;
-                continue;
+        for (uint32_t k = 0, w = first_word; k <= words; ++k, w = w + 1 == words ? 0 : w + 1) {
+            // The first word is visited twice: its bits from the pointer up, last the ones below.
+            uint64_t bits = requested_[w];
+            if (k == 0) bits &= ~below_start;
+            else if (k == words) bits &= below_start;
+            else if (w == first_word) continue;
+            for (; bits != 0; bits &= bits - 1) {
+                if (!try_start(now)) break;  // no unit frees up within a cycle: the rest lose too
+                const uint32_t id = (w << 6) + static_cast<uint32_t>(std::countr_zero(bits));
+                on_grant(id, now + config_.latency);
+                last_granted = id;
+                --requests_;
             }
-            on_grant(id, now + config_.latency);
-            last_granted = id;
         }
-        if (last_granted != kNone) next_priority_ = (last_granted + 1) % num_requesters_;
-        pending_.clear();
+        const uint32_t denied = requests_;
+        counters_.denied += denied;
+        if (last_granted != kNone)
+            next_priority_ = last_granted + 1 == num_requesters_ ? 0 : last_granted + 1;
+        std::fill(requested_.begin(), requested_.end(), 0);
+        requests_ = 0;
+        return denied;
     }
 
     const Counters& counters() const { return counters_; }
@@ -59,13 +80,13 @@ public:
 
 private:
     static constexpr uint32_t kNone = UINT32_MAX;
-    void order_by_priority();
     bool try_start(uint64_t now);
 
     FuConfig config_;
     uint32_t num_requesters_;
     uint32_t next_priority_ = 0;          // requester that wins first next time
-    std::vector<uint32_t> pending_;
+    std::vector<uint64_t> requested_;     // bit per requester, this cycle
+    uint32_t requests_ = 0;               // bits set in requested_
     std::vector<uint64_t> unit_free_at_;  // per unit, if not pipelined: first cycle it can start
     uint64_t starts_cycle_ = UINT64_MAX;  // if pipelined: operations started in cycle starts_cycle_
     uint32_t starts_ = 0;

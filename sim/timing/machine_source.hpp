@@ -20,6 +20,8 @@ class MachineSource final : public InstructionSource {
 public:
     explicit MachineSource(core::Machine& machine) : machine_(machine) {}
 
+    core::Machine& machine() const { return machine_; }
+
     uint32_t next_pc(uint32_t thread) const override { return machine_.thread(thread).hart.pc; }
 
     StepInfo step(uint32_t thread) override {
