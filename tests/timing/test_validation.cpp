@@ -202,3 +202,25 @@ TEST_CASE("a streaming kernel saturates the DRAM bandwidth and no more", "[valid
         CHECK(achieved >= 0.8 * peak);
     }
 }
+
+TEST_CASE("rdcycle reads the chip's cycle in timing mode and instret without a timing model",
+          "[validation]") {
+    constexpr uint64_t kSteps = 64;  // fdiv.s in the guest's timed chain (-DSTEPS)
+    ChipConfig c = tiny();
+    c.fu.fp_divsqrt.latency = 11;
+    // A dependent chain of N steps of latency L takes N x L cycles; the reads themselves, the
+    // first fdiv's issue and the fmv that waits for the result add a couple of cycles.
+    auto timed = run_program("rdcycle_fdiv", c);
+    const auto guest_cycles = uint64_t(timed->machine->thread(0).exit_code);
+    CHECK(guest_cycles >= kSteps * 11);
+    CHECK(guest_cycles <= kSteps * 11 + 4);
+
+    // Functionally every instruction is one cycle: the second read sees the first read, the
+    // chain and the fmv retired.
+    core::MachineConfig functional = machine_config_for(c);
+    functional.global_bytes = kGlobalBytes;
+    core::Machine machine(core::load_elf(std::string(TPSIM_TIMING_PROGRAMS) + "/rdcycle_fdiv.elf"),
+                          functional);
+    machine.run();
+    CHECK(uint64_t(machine.thread(0).exit_code) == kSteps + 2);
+}
