@@ -8,10 +8,16 @@
 
 int main(int argc, char** argv) {
     CLI::App app{"tpsim: a cycle-counting simulator of TRaX ray-tracing hardware"};
-    app.require_subcommand(1);
+    // At most one; none is reported below, so that a misspelt subcommand is named as such
+    // instead of "A subcommand is required".
+    app.require_subcommand(0, 1);
     const tpsim::cli::Command commands[] = {tpsim::cli::add_render_command(app),
                                             tpsim::cli::add_exec_command(app)};
     CLI11_PARSE(app, argc, argv);
+    if (app.get_subcommands().empty()) {
+        fmt::print(stderr, "tpsim: give a subcommand: render or exec (tpsim --help)\n");
+        return 2;
+    }
     try {
         for (const tpsim::cli::Command& command : commands)
             if (command.parser->parsed()) return command.run();

@@ -157,7 +157,8 @@ Command add_render_command(CLI::App& app) {
                         "Image to write (.png 8-bit sRGB; .exr/.tif linear float) [default: SCENE.png]");
     command->add_option("-k,--kernel", o->kernel, "Built kernel name, or a path to a kernel ELF")
         ->capture_default_str();
-    command->add_option("-c,--config", o->config, "Chip configuration TOML (e.g. configs/trax.toml)")
+    command->add_option("-c,--config", o->config, "Chip configuration TOML (e.g. configs/tiny.toml) [default: built-in, the same as "
+                        "configs/trax.toml]")
         ->check(CLI::ExistingFile);
     command->add_option("-s,--set", o->overrides,
                         "Override one chip configuration field, e.g. --set chip.num_tms=8");
