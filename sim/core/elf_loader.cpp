@@ -278,9 +278,13 @@ std::optional<SourceLocation> Program::source_at(uint32_t pc) const {
     auto it = std::upper_bound(line_rows.begin(), line_rows.end(), pc,
                                [](uint32_t a, const LineRow& r) { return a < r.address; });
     if (it == line_rows.begin()) return std::nullopt;
-    const LineRow& row = *std::prev(it);
-    if (row.end_sequence || row.line == 0) return std::nullopt;
-    return SourceLocation{line_files[row.file], row.line};
+    // Line 0 marks code the compiler attributes to no line (e.g. a load scheduled between two
+    // statements); report the closest line before it in the same sequence, as debuggers do.
+    auto row = std::prev(it);
+    while (row->line == 0 && !row->end_sequence && row != line_rows.begin())
+        --row;
+    if (row->end_sequence || row->line == 0) return std::nullopt;
+    return SourceLocation{line_files[row->file], row->line};
 }
 
 const Segment* Program::segment_at(uint32_t addr) const {
