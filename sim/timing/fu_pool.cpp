@@ -51,27 +51,6 @@ FuPool::FuPool(const FuConfig& config, uint32_t num_requesters)
         throw std::invalid_argument("FuPool: needs at least one requester and one unit");
 }
 
-bool FuPool::try_start(uint64_t now) {
-    if (config_.pipelined) {
-        // Every pipelined unit is free again one cycle after it started, so which unit takes an
-        // operation is unobservable: counting this cycle's starts is enough.
-        if (starts_cycle_ != now) starts_cycle_ = now, starts_ = 0;
-        if (starts_ == config_.count) return false;
-        ++starts_;
-        ++counters_.issued;
-        ++counters_.unit_busy_cycles;
-        return true;
-    }
-    for (uint64_t& free_at : unit_free_at_) {
-        if (free_at > now) continue;
-        free_at = now + config_.latency;  // not pipelined: busy until the result is out
-        ++counters_.issued;
-        counters_.unit_busy_cycles += config_.latency;
-        return true;
-    }
-    return false;
-}
-
 void FuPool::register_stats(stats::Registry& r, std::string_view prefix) const {
     r.add_counter(fmt::format("{}/issued", prefix), counters_.issued, "operations started");
     r.add_counter(fmt::format("{}/denied", prefix), counters_.denied,

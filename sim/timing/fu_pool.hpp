@@ -80,7 +80,7 @@ public:
 
 private:
     static constexpr uint32_t kNone = UINT32_MAX;
-    bool try_start(uint64_t now);
+    bool try_start(uint64_t now);  // inline below: called once per simulated instruction
 
     FuConfig config_;
     uint32_t num_requesters_;
@@ -92,5 +92,26 @@ private:
     uint32_t starts_ = 0;
     Counters counters_;
 };
+
+inline bool FuPool::try_start(uint64_t now) {
+    if (config_.pipelined) {
+        // Every pipelined unit is free again one cycle after it started, so which unit takes an
+        // operation is unobservable: counting this cycle's starts is enough.
+        if (starts_cycle_ != now) starts_cycle_ = now, starts_ = 0;
+        if (starts_ == config_.count) return false;
+        ++starts_;
+        ++counters_.issued;
+        ++counters_.unit_busy_cycles;
+        return true;
+    }
+    for (uint64_t& free_at : unit_free_at_) {
+        if (free_at > now) continue;
+        free_at = now + config_.latency;  // not pipelined: busy until the result is out
+        ++counters_.issued;
+        counters_.unit_busy_cycles += config_.latency;
+        return true;
+    }
+    return false;
+}
 
 }  // namespace tpsim::timing
