@@ -13,7 +13,12 @@ int main(int argc, char** argv) {
     app.require_subcommand(0, 1);
     const tpsim::cli::Command commands[] = {tpsim::cli::add_render_command(app),
                                             tpsim::cli::add_exec_command(app)};
-    CLI11_PARSE(app, argc, argv);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        // CLI11 prints the problem (or the help); a usage error exits 2 like every other error.
+        return app.exit(e) == 0 ? 0 : 2;
+    }
     if (app.get_subcommands().empty()) {
         fmt::print(stderr, "tpsim: give a subcommand: render or exec (tpsim --help)\n");
         return 2;

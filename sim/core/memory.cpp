@@ -81,7 +81,8 @@ void Memory::fault(uint32_t addr, uint32_t bytes, bool store) const {
         throw GuestFault{FaultKind::StackOverflow,
                          fmt::format("{}, below the {}-byte local store {}", what, local_.size,
                                      range(local_.base, kLocalTop)),
-                         "reduce recursion/locals or raise --local-store"};
+                         "reduce recursion/locals or enlarge the local store "
+                         "(exec --local-store N, render --set tp.local_store_bytes=N)"};
 
     const Region* region = nullptr;
     if (addr - local_.base < local_.size)

@@ -20,6 +20,9 @@ namespace tpsim::render {
 namespace {
 
 constexpr size_t kErrorBytes = 1024;
+/// The host has no instruction limit, so a twin stuck in an endless loop is stopped after this
+/// long; real renders take seconds natively (the 1.5 M-triangle stress scene well under one).
+constexpr unsigned kTimeLimitSeconds = 600;
 
 /// Memory shared with the child process that runs the twin; unmapped when it goes.
 class SharedMapping {
@@ -50,6 +53,10 @@ std::string describe_signal(int signal) {
         case SIGFPE: return "SIGFPE: an integer division by zero";
         case SIGILL: return "SIGILL: an illegal instruction";
         case SIGABRT: return "SIGABRT: the kernel aborted";
+        case SIGALRM:
+            return fmt::format("no result after {} s (an endless loop? the simulator stops one "
+                               "with --max-instructions and names where it is)",
+                               kTimeLimitSeconds);
         default: return fmt::format("signal {} ({})", signal, strsignal(signal));
     }
 }
@@ -88,7 +95,10 @@ void run_native_twin(const std::filesystem::path& library, std::vector<uint32_t>
     const pid_t child = fork();
     if (child < 0) throw Error(fmt::format("cannot start the native twin: fork failed: {}",
                                            std::strerror(errno)));
-    if (child == 0) _exit(run(&context) == 0 ? 0 : 1);
+    if (child == 0) {
+        alarm(kTimeLimitSeconds);
+        _exit(run(&context) == 0 ? 0 : 1);
+    }
 
     int status = 0;
     while (waitpid(child, &status, 0) < 0)
@@ -96,7 +106,7 @@ void run_native_twin(const std::filesystem::path& library, std::vector<uint32_t>
             throw Error(fmt::format("lost the native twin's process: {}", std::strerror(errno)));
     if (WIFSIGNALED(status))
         throw Error(fmt::format(
-            "the native twin '{}' crashed with {}; run without --native to have the simulator "
+            "the native twin '{}' stopped: {}; run without --native to have the simulator "
             "name the thread, pc and source line, or debug the twin with gdb",
             library.filename().string(), describe_signal(WTERMSIG(status))));
     if (WEXITSTATUS(status) != 0)

@@ -149,7 +149,8 @@ TEST_CASE("unbounded recursion is a stack overflow in the recursive function", "
     CHECK_THAT(message, Catch::Contains(fmt::format("stack_overflow.c:{})", line)));
     CHECK_THAT(message,
                Catch::Contains("below the 1024-byte local store [0x7ffffc00, 0x80000000)"));
-    CHECK_THAT(message, Catch::EndsWith("reduce recursion/locals or raise --local-store"));
+    CHECK_THAT(message, Catch::EndsWith("reduce recursion/locals or enlarge the local store "
+                                        "(exec --local-store N, render --set tp.local_store_bytes=N)"));
 }
 
 TEST_CASE("a runaway thread stops at the instruction limit", "[sim][machine]") {
