@@ -84,6 +84,8 @@ class Machine {
     const MachineConfig& config() const { return config_; }
     Memory& memory() { return memory_; }
     const Memory& memory() const { return memory_; }
+    /// The pc thread `id` executes next; unchecked (the timing model asks once per instruction).
+    uint32_t next_pc(uint32_t id) const { return threads_[id].hart.pc; }
     Thread& thread(uint32_t id) { return threads_.at(id); }
     const Thread& thread(uint32_t id) const { return threads_.at(id); }
     uint32_t thread_count() const { return uint32_t(threads_.size()); }

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <bit>
+
 #include <stdexcept>
 
 namespace tpsim::timing {
@@ -135,10 +137,13 @@ void Cache::register_stats(stats::Registry& r, std::string_view prefix) const {
 }
 
 ICacheBanks::ICacheBanks(const ICacheConfig& config, uint32_t num_threads)
-    : threads_per_icache_(config.threads_per_icache),
-      banks_per_icache_(config.banks),
+    : banks_per_icache_(config.banks),
+      bank_mask_(config.banks > 1 && std::has_single_bit(config.banks) ? config.banks - 1 : 0),
       banks_(size_t{(num_threads + config.threads_per_icache - 1) / config.threads_per_icache} *
-             config.banks) {}
+             config.banks) {
+    for (uint32_t tp = 0; tp < num_threads; ++tp)
+        first_bank_.push_back(tp / config.threads_per_icache * config.banks);
+}
 
 void ICacheBanks::register_stats(stats::Registry& r, std::string_view prefix) const {
     r.add_counter(fmt::format("{}/fetches", prefix), counters_.fetches, "instructions fetched");

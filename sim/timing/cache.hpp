@@ -107,8 +107,11 @@ public:
     /// Thread `tp` fetches `pc` in cycle `now`; false = conflict, try again next cycle.
     /// Within a cycle, earlier callers win: the caller decides the (rotating) order.
     bool fetch(uint64_t now, uint32_t tp, uint32_t pc) {
-        Bank& bank = banks_[size_t{tp / threads_per_icache_} * banks_per_icache_ +
-                            (pc / 4) % banks_per_icache_];
+        // No division per fetch (once per simulated instruction): the thread's first bank is
+        // precomputed, and a power-of-two bank count is a mask.
+        const uint32_t word = pc / 4;
+        const uint32_t in_icache = bank_mask_ ? word & bank_mask_ : word % banks_per_icache_;
+        Bank& bank = banks_[first_bank_[tp] + in_icache];
         if (bank.cycle == now && bank.pc != pc) {
             ++counters_.conflicts;
             return false;
@@ -126,8 +129,9 @@ private:
         uint64_t cycle = UINT64_MAX;  // cycle of the current reservation
         uint32_t pc = 0;
     };
-    uint32_t threads_per_icache_;
     uint32_t banks_per_icache_;
+    uint32_t bank_mask_;                // banks - 1 if a power of two above 1, else 0
+    std::vector<uint32_t> first_bank_;  // per thread: index of its I-cache's bank 0
     std::vector<Bank> banks_;  // all I-caches of the TM, banks_per_icache_ each
     Counters counters_;
 };

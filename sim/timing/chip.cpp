@@ -30,6 +30,7 @@ struct Chip::Tm {
         StepInfo pending;            // fetched, not yet issued
         isa::FuClass pending_class{};
         Pool pending_pool{};
+        std::array<uint8_t, 4> pending_regs{};  // rs1, rs2, rs3, rd; kNoReg as kNumRegs
         bool has_pending = false;
         bool done = false;
         uint64_t fetch_at = 0;       // earliest cycle of the next fetch (branch bubbles)
@@ -224,9 +225,12 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
         }
     }
 
-    // Fetch, scoreboard check, FU request.
+    // Fetch, scoreboard check, FU request. Base pointers in locals: the loop's byte-sized
+    // stores could alias the vectors' internals, which would make the compiler reload them.
+    Tm::Tp* const tps = tm.tps.data();
+    const uint32_t first_thread = tm.id * n;
     for (uint32_t k = 0, i = tm.rotation; k < n; ++k, i = i + 1 == n ? 0 : i + 1) {
-        Tm::Tp& tp = tm.tps[i];
+        Tm::Tp& tp = tps[i];
         if (tp.done || now < tp.wake_at) continue;
         ++tm.counters.active_tp_cycles;
         if (!tp.has_pending) {
@@ -234,21 +238,24 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
                 ++tm.counters.stalls[size_t(Stall::Branch)];
                 continue;
             }
-            const uint32_t thread = tm.id * n + i;
+            const uint32_t thread = first_thread + i;
             if (!tm.icache.fetch(now, i, source.next_pc(thread))) {
                 ++tm.counters.stalls[size_t(Stall::FetchConflict)];
                 continue;
             }
             tp.pending = source.step(thread);
-            tp.pending_class = class_of_[size_t(tp.pending.insn->op)];
-            tp.pending_pool = pool_of_[size_t(tp.pending.insn->op)];
+            const isa::Decoded& d = *tp.pending.insn;
+            tp.pending_class = class_of_[size_t(d.op)];
+            tp.pending_pool = pool_of_[size_t(d.op)];
+            // rd too: no write-after-write reorder. kNoReg maps to the always-ready last slot.
+            tp.pending_regs = {std::min(d.rs1, isa::kNumRegs), std::min(d.rs2, isa::kNumRegs),
+                               std::min(d.rs3, isa::kNumRegs), std::min(d.rd, isa::kNumRegs)};
             tp.has_pending = true;
         }
         const isa::Decoded& d = *tp.pending.insn;
-        // rd too: no write-after-write reorder. kNoReg maps to the always-ready last slot.
-        const auto ready_at = [&](uint8_t r) { return tp.reg_ready[std::min(r, isa::kNumRegs)]; };
+        const auto ready_at = [&](size_t slot) { return tp.reg_ready[tp.pending_regs[slot]]; };
         const uint64_t operands_at =
-            std::max(std::max(ready_at(d.rs1), ready_at(d.rs2)), std::max(ready_at(d.rs3), ready_at(d.rd)));
+            std::max(std::max(ready_at(0), ready_at(1)), std::max(ready_at(2), ready_at(3)));
         if (operands_at > now) {
             Pool blocking = Pool::IntAlu;  // producer of the first operand that is ready last
             for (uint8_t r : {d.rs1, d.rs2, d.rs3, d.rd})

@@ -22,7 +22,7 @@ public:
 
     core::Machine& machine() const { return machine_; }
 
-    uint32_t next_pc(uint32_t thread) const override { return machine_.thread(thread).hart.pc; }
+    uint32_t next_pc(uint32_t thread) const override { return machine_.next_pc(thread); }
 
     StepInfo step(uint32_t thread) override {
         const core::StepRecord r = machine_.step(thread);
