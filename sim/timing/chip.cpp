@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <bit>
 #include <stdexcept>
 
 namespace tpsim::timing {
@@ -18,6 +19,24 @@ constexpr size_t kPools = static_cast<size_t>(Pool::Count);
 constexpr size_t kStalls = static_cast<size_t>(Stall::Count);
 
 bool is_local(uint32_t addr) { return addr >= trax::map::kLocalTop - trax::map::kStackGuard; }
+
+/// Calls f(i) for every set bit i of `bits` in rotating order: start, start + 1, ..., wrapping
+/// to 0 (the order of the TP loops, without visiting the clear bits).
+template <class F>
+void for_each_bit_from(const std::vector<uint64_t>& bits, uint32_t start, F&& f) {
+    const auto visit = [&](uint32_t w, uint64_t word) {
+        for (; word != 0; word &= word - 1) f((w << 6) + static_cast<uint32_t>(std::countr_zero(word)));
+    };
+    const uint32_t words = static_cast<uint32_t>(bits.size());
+    const uint32_t first_word = start >> 6;
+    const uint64_t below_start = (uint64_t{1} << (start & 63)) - 1;
+    visit(first_word, bits[first_word] & ~below_start);
+    for (uint32_t k = 1, w = first_word; k < words; ++k) {
+        w = w + 1 == words ? 0 : w + 1;
+        visit(w, bits[w]);
+    }
+    visit(first_word, bits[first_word] & below_start);
+}
 
 }  // namespace
 
@@ -56,7 +75,8 @@ struct Chip::Tm {
     };
 
     Tm(const ChipConfig& c, uint32_t id)
-        : id(id), tps(c.chip.tps_per_tm), icache(c.icache, c.chip.tps_per_tm), l1(c.l1) {
+        : id(id), tps(c.chip.tps_per_tm), icache(c.icache, c.chip.tps_per_tm), l1(c.l1),
+          mem_waiting_tps((c.chip.tps_per_tm + 63) / 64) {
         for (size_t p = 0; p < kPools; ++p)
             pools.emplace_back(pool_config(c.fu, Pool(p)), c.chip.tps_per_tm);
     }
@@ -82,7 +102,7 @@ struct Chip::Tm {
     uint32_t atomic_sequence = 0;
     std::vector<AtomicRequest> atomics_out;  // sent this cycle, collected by the chip
     uint32_t running = 0;
-    uint32_t mem_waiting = 0;     // TPs with mem_waiting set
+    std::vector<uint64_t> mem_waiting_tps;  // bit per TP with mem_waiting set
     Counters counters;
 };
 
@@ -215,15 +235,14 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
     if (tm.running == 0) return;
 
     // Granted loads/stores take their L1 bank in rotating order.
-    for (uint32_t k = 0, i = tm.rotation; tm.mem_waiting != 0 && k < n;
-         ++k, i = i + 1 == n ? 0 : i + 1) {
+    for_each_bit_from(tm.mem_waiting_tps, tm.rotation, [&](uint32_t i) {
         Tm::Tp& tp = tm.tps[i];
-        if (!tp.mem_waiting || tp.mem_at > now) continue;
+        if (tp.mem_at > now) return;
         if (accepted(tm.l1.access(now, tp.mem_request))) {
             tp.mem_waiting = false;
-            --tm.mem_waiting;
+            tm.mem_waiting_tps[i >> 6] &= ~(uint64_t{1} << (i & 63));
         }
-    }
+    });
 
     // Fetch, scoreboard check, FU request. Base pointers in locals: the loop's byte-sized
     // stores could alias the vectors' internals, which would make the compiler reload them.
@@ -305,7 +324,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
                 result_at = ready + config_.tp.local_store_latency;
             } else if (s.mem_bytes != 0) {
                 tp.mem_waiting = true;
-                ++tm.mem_waiting;
+                tm.mem_waiting_tps[i >> 6] |= uint64_t{1} << (i & 63);
                 tp.mem_at = ready;
                 tp.mem_request = {s.mem_address, i, d.rd, s.mem_store};
                 result_at = kNever;  // set by the L1 reply
