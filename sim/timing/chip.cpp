@@ -20,12 +20,18 @@ constexpr size_t kStalls = static_cast<size_t>(Stall::Count);
 
 bool is_local(uint32_t addr) { return addr >= trax::map::kLocalTop - trax::map::kStackGuard; }
 
+void set_bit(std::vector<uint64_t>& bits, uint32_t i) { bits[i >> 6] |= uint64_t{1} << (i & 63); }
+void clear_bit(std::vector<uint64_t>& bits, uint32_t i) {
+    bits[i >> 6] &= ~(uint64_t{1} << (i & 63));
+}
+
 /// Calls f(i) for every set bit i of `bits` in rotating order: start, start + 1, ..., wrapping
 /// to 0 (the order of the TP loops, without visiting the clear bits).
 template <class F>
 void for_each_bit_from(const std::vector<uint64_t>& bits, uint32_t start, F&& f) {
     const auto visit = [&](uint32_t w, uint64_t word) {
-        for (; word != 0; word &= word - 1) f((w << 6) + static_cast<uint32_t>(std::countr_zero(word)));
+        for (; word != 0; word &= word - 1)
+            f((w << 6) + static_cast<uint32_t>(std::countr_zero(word)));
     };
     const uint32_t words = static_cast<uint32_t>(bits.size());
     const uint32_t first_word = start >> 6;
@@ -76,7 +82,8 @@ struct Chip::Tm {
 
     Tm(const ChipConfig& c, uint32_t id)
         : id(id), tps(c.chip.tps_per_tm), icache(c.icache, c.chip.tps_per_tm), l1(c.l1),
-          mem_waiting_tps((c.chip.tps_per_tm + 63) / 64) {
+          mem_waiting_tps((c.chip.tps_per_tm + 63) / 64), awake_tps(mem_waiting_tps.size()) {
+        for (uint32_t i = 0; i < c.chip.tps_per_tm; ++i) set_bit(awake_tps, i);
         for (size_t p = 0; p < kPools; ++p)
             pools.emplace_back(pool_config(c.fu, Pool(p)), c.chip.tps_per_tm);
     }
@@ -87,8 +94,10 @@ struct Chip::Tm {
         counters.operand_stalls[size_t(blocking)] += cycles;
     }
     /// A reply for `tp` arrived: a TP asleep until then gets its stall cycles and runs again.
-    void wake(Tp& tp, uint64_t now) {
+    void wake(uint32_t i, uint64_t now) {
+        Tp& tp = tps[i];
         if (tp.wake_at != kNever) return;
+        set_bit(awake_tps, i);
         add_operand_stalls(tp.asleep_on, now - tp.asleep_from);
         tp.wake_at = now;
     }
@@ -103,6 +112,9 @@ struct Chip::Tm {
     std::vector<AtomicRequest> atomics_out;  // sent this cycle, collected by the chip
     uint32_t running = 0;
     std::vector<uint64_t> mem_waiting_tps;  // bit per TP with mem_waiting set
+    // Bit per TP that is neither done nor asleep until a reply (wake_at == kNever): the TP
+    // loop visits only these.
+    std::vector<uint64_t> awake_tps;
     Counters counters;
 };
 
@@ -215,9 +227,8 @@ void Chip::tick_shared(uint64_t now) {
     AtomicReply atomic;
     while (global_registers_.pop_reply(now, atomic)) {
         Tm& tm = *tms_[atomic.request.tm];
-        Tm::Tp& tp = tm.tps[atomic.request.tp];
-        tp.reg_ready[atomic.request.tag] = now;
-        tm.wake(tp, now);
+        tm.tps[atomic.request.tp].reg_ready[atomic.request.tag] = now;
+        tm.wake(atomic.request.tp, now);
         ++progress_;
     }
 }
@@ -227,9 +238,8 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
     const uint32_t n = static_cast<uint32_t>(tm.tps.size());
     MemReply reply;
     while (tm.l1.pop_reply(now, reply)) {
-        Tm::Tp& tp = tm.tps[reply.request.source];
-        tp.reg_ready[reply.request.tag] = now;
-        tm.wake(tp, now);
+        tm.tps[reply.request.source].reg_ready[reply.request.tag] = now;
+        tm.wake(reply.request.source, now);
         ++progress_;
     }
     if (tm.running == 0) return;
@@ -240,7 +250,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
         if (tp.mem_at > now) return;
         if (accepted(tm.l1.access(now, tp.mem_request))) {
             tp.mem_waiting = false;
-            tm.mem_waiting_tps[i >> 6] &= ~(uint64_t{1} << (i & 63));
+            clear_bit(tm.mem_waiting_tps, i);
         }
     });
 
@@ -248,59 +258,70 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
     // stores could alias the vectors' internals, which would make the compiler reload them.
     Tm::Tp* const tps = tm.tps.data();
     const uint32_t first_thread = tm.id * n;
-    for (uint32_t k = 0, i = tm.rotation; k < n; ++k, i = i + 1 == n ? 0 : i + 1) {
-        Tm::Tp& tp = tps[i];
-        if (tp.done || now < tp.wake_at) continue;
-        ++tm.counters.active_tp_cycles;
-        if (!tp.has_pending) {
-            if (now < tp.fetch_at) {
-                ++tm.counters.stalls[size_t(Stall::Branch)];
-                continue;
-            }
-            const uint32_t thread = first_thread + i;
-            if (!tm.icache.fetch(now, i, source.next_pc(thread))) {
-                ++tm.counters.stalls[size_t(Stall::FetchConflict)];
-                continue;
-            }
-            tp.pending = source.step(thread);
-            const isa::Decoded& d = *tp.pending.insn;
-            tp.pending_class = class_of_[size_t(d.op)];
-            tp.pending_pool = pool_of_[size_t(d.op)];
-            // rd too: no write-after-write reorder. kNoReg maps to the always-ready last slot.
-            tp.pending_regs = {std::min(d.rs1, isa::kNumRegs), std::min(d.rs2, isa::kNumRegs),
-                               std::min(d.rs3, isa::kNumRegs), std::min(d.rd, isa::kNumRegs)};
-            tp.has_pending = true;
-        }
-        const isa::Decoded& d = *tp.pending.insn;
-        const auto ready_at = [&](size_t slot) { return tp.reg_ready[tp.pending_regs[slot]]; };
-        const uint64_t operands_at =
-            std::max(std::max(ready_at(0), ready_at(1)), std::max(ready_at(2), ready_at(3)));
-        if (operands_at > now) {
-            Pool blocking = Pool::IntAlu;  // producer of the first operand that is ready last
-            for (uint8_t r : {d.rs1, d.rs2, d.rs3, d.rd})
-                if (r != isa::kNoReg && tp.reg_ready[r] == operands_at) {
-                    blocking = tp.reg_producer[r];
-                    break;
+    // Awake TPs in rotating order, as for_each_bit_from, spelled out so the body stays inline.
+    const uint32_t words = static_cast<uint32_t>(tm.awake_tps.size());
+    const uint32_t first_word = tm.rotation >> 6;
+    const uint64_t below_start = (uint64_t{1} << (tm.rotation & 63)) - 1;
+    for (uint32_t k = 0, w = first_word; k <= words; ++k, w = w + 1 == words ? 0 : w + 1) {
+        // The first word twice: its bits from the rotation up, last the ones below.
+        const uint64_t part = k == 0 ? ~below_start : k == words ? below_start : ~uint64_t{0};
+        uint64_t bits = tm.awake_tps[w] & part;
+        for (; bits != 0; bits &= bits - 1) {
+            const uint32_t i = (w << 6) + static_cast<uint32_t>(std::countr_zero(bits));
+            Tm::Tp& tp = tps[i];
+            if (now < tp.wake_at) continue;  // asleep until a known cycle
+            ++tm.counters.active_tp_cycles;
+            if (!tp.has_pending) {
+                if (now < tp.fetch_at) {
+                    ++tm.counters.stalls[size_t(Stall::Branch)];
+                    continue;
                 }
-            ++tm.counters.stalls[size_t(Stall::Operand)];
-            ++tm.counters.operand_stalls[size_t(blocking)];
-            // Nothing can change this wait before operands_at but a reply for this TP, which
-            // wakes it; so the cycles in between are operand stalls on `blocking`.
-            tp.wake_at = operands_at;
-            if (operands_at == kNever) {
-                tp.asleep_from = now + 1;
-                tp.asleep_on = blocking;
-            } else {
-                tm.add_operand_stalls(blocking, operands_at - now - 1);
+                const uint32_t thread = first_thread + i;
+                if (!tm.icache.fetch(now, i, source.next_pc(thread))) {
+                    ++tm.counters.stalls[size_t(Stall::FetchConflict)];
+                    continue;
+                }
+                tp.pending = source.step(thread);
+                const isa::Decoded& d = *tp.pending.insn;
+                tp.pending_class = class_of_[size_t(d.op)];
+                tp.pending_pool = pool_of_[size_t(d.op)];
+                // rd too: no write-after-write reorder. kNoReg maps to the always-ready last slot.
+                tp.pending_regs = {std::min(d.rs1, isa::kNumRegs), std::min(d.rs2, isa::kNumRegs),
+                                   std::min(d.rs3, isa::kNumRegs), std::min(d.rd, isa::kNumRegs)};
+                tp.has_pending = true;
             }
-            continue;
+            const isa::Decoded& d = *tp.pending.insn;
+            const auto ready_at = [&](size_t slot) { return tp.reg_ready[tp.pending_regs[slot]]; };
+            const uint64_t operands_at =
+                std::max(std::max(ready_at(0), ready_at(1)), std::max(ready_at(2), ready_at(3)));
+            if (operands_at > now) {
+                Pool blocking = Pool::IntAlu;  // producer of the first operand that is ready last
+                for (uint8_t r : {d.rs1, d.rs2, d.rs3, d.rd})
+                    if (r != isa::kNoReg && tp.reg_ready[r] == operands_at) {
+                        blocking = tp.reg_producer[r];
+                        break;
+                    }
+                ++tm.counters.stalls[size_t(Stall::Operand)];
+                ++tm.counters.operand_stalls[size_t(blocking)];
+                // Nothing can change this wait before operands_at but a reply for this TP, which
+                // wakes it; so the cycles in between are operand stalls on `blocking`.
+                tp.wake_at = operands_at;
+                if (operands_at == kNever) {
+                    clear_bit(tm.awake_tps, i);
+                    tp.asleep_from = now + 1;
+                    tp.asleep_on = blocking;
+                } else {
+                    tm.add_operand_stalls(blocking, operands_at - now - 1);
+                }
+                continue;
+            }
+            const Pool pool = tp.pending_pool;
+            if (pool == Pool::LoadStore && tp.mem_waiting && !is_local(tp.pending.mem_address)) {
+                ++tm.counters.stalls[size_t(Stall::MemoryPort)];
+                continue;
+            }
+            tm.pools[size_t(pool)].request(i);
         }
-        const Pool pool = tp.pending_pool;
-        if (pool == Pool::LoadStore && tp.mem_waiting && !is_local(tp.pending.mem_address)) {
-            ++tm.counters.stalls[size_t(Stall::MemoryPort)];
-            continue;
-        }
-        tm.pools[size_t(pool)].request(i);
     }
 
     // Requests the pools refuse are the FU-busy stalls (the TP keeps its instruction).
@@ -324,7 +345,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
                 result_at = ready + config_.tp.local_store_latency;
             } else if (s.mem_bytes != 0) {
                 tp.mem_waiting = true;
-                tm.mem_waiting_tps[i >> 6] |= uint64_t{1} << (i & 63);
+                set_bit(tm.mem_waiting_tps, i);
                 tp.mem_at = ready;
                 tp.mem_request = {s.mem_address, i, d.rd, s.mem_store};
                 result_at = kNever;  // set by the L1 reply
@@ -341,6 +362,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             tp.has_pending = false;
             if (s.exited) {
                 tp.done = true;
+                clear_bit(tm.awake_tps, i);
                 --tm.running;
             }
         });
