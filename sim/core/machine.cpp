@@ -18,31 +18,28 @@ constexpr uint32_t kCauseIllegal = 2; // mcause values of the privileged spec
 constexpr uint32_t kCauseEcallM = 11;
 constexpr unsigned kA0 = 10, kA7 = 17, kSp = 2;
 
-/// Collects the memory access of one instruction for step(); empty in the fast path.
-struct AccessRecorder {
-    uint32_t address = 0;
-    uint8_t bytes = 0;
-    bool store = false;
-};
 struct NoRecorder {};
 
 } // namespace
 
-/// The isa::execute environment of one thread. kRecord adds the bookkeeping step() reports; the
-/// fast path instantiates it away.
+/// The isa::execute environment of one thread. kRecord adds the bookkeeping step() reports,
+/// written straight into its record; the fast path instantiates it away.
 template <bool kRecord> class ThreadEnv {
   public:
-    ThreadEnv(Machine& machine, uint32_t id)
+    using Record = std::conditional_t<kRecord, StepRecord*, NoRecorder>;
+
+    ThreadEnv(Machine& machine, uint32_t id, Record record = {})
         : machine_(machine), memory_(machine.memory_), thread_(machine.threads_[id]),
-          h_(thread_.hart), id_(id), local_(machine.memory_.local_store(id).data()) {}
+          h_(thread_.hart), id_(id), local_(machine.memory_.local_store(id).data()),
+          record_(record) {}
 
     template <class T> T load(uint32_t addr) {
-        if constexpr (kRecord) access_ = {addr, uint8_t(sizeof(T)), false};
+        if constexpr (kRecord) record_access(addr, sizeof(T), false);
         return memory_.load<T>(addr, local_);
     }
 
     template <class T> void store(uint32_t addr, T value) {
-        if constexpr (kRecord) access_ = {addr, uint8_t(sizeof(T)), true};
+        if constexpr (kRecord) record_access(addr, sizeof(T), true);
         memory_.store<T>(addr, value, local_);
     }
 
@@ -104,7 +101,7 @@ template <bool kRecord> class ThreadEnv {
             thread_.exit_code = int32_t(h.reg[kA0]);
             thread_.exit_pc = h.pc;
             h.pc = kParkedPc;
-            if constexpr (kRecord) exited_ = true;
+            if constexpr (kRecord) record_->exited = true;
             return;
         }
         if (h.mtvec != 0) return isa::trap(h, kCauseEcallM, 0);
@@ -143,18 +140,20 @@ template <bool kRecord> class ThreadEnv {
                          "set frm to 0..4 (fsrm) or give the instruction a static rounding mode"};
     }
 
-    AccessRecorder access() const { return access_; }
-    bool exited() const { return exited_; }
-
   private:
+    void record_access(uint32_t addr, uint8_t bytes, bool store) {
+        record_->mem_address = addr;
+        record_->mem_bytes = bytes;
+        record_->mem_store = store;
+    }
+
     Machine& machine_;
     Memory& memory_;
     Thread& thread_;
     const isa::Hart& h_;
     uint32_t id_;
     uint8_t* local_;
-    [[no_unique_address]] std::conditional_t<kRecord, AccessRecorder, NoRecorder> access_{};
-    bool exited_ = false;
+    [[no_unique_address]] Record record_;
 };
 
 void MachineConfig::validate() const {
@@ -301,10 +300,12 @@ void Machine::refuse_step(uint32_t id) {
 // The timing model's hot path (once per simulated instruction): every check in one unlikely
 // branch, the environment built inline, the fault paths out of line.
 StepRecord Machine::step(uint32_t id) {
-    if (id >= threads_.size() || threads_[id].state != ThreadState::Running ||
-        threads_[id].executed == config_.max_instructions) [[unlikely]]
+    // config_.threads, not threads_.size(): no division by sizeof(Thread).
+    if (id >= config_.threads) [[unlikely]]
         refuse_step(id);
     Thread& t = threads_[id];
+    if (t.state != ThreadState::Running || t.executed == config_.max_instructions) [[unlikely]]
+        refuse_step(id);
     isa::Hart& h = t.hart;
     const uint32_t pc = h.pc;
     const uint32_t index = std::rotr(pc - text_base_, 2); // range and alignment, as in run_quantum
@@ -312,7 +313,10 @@ StepRecord Machine::step(uint32_t id) {
         fetch_fault(id, pc);
     const isa::Decoded& d = decoded_[index];
     ++counters_.per_op[size_t(d.op)];
-    ThreadEnv<true> env(*this, id);
+    StepRecord record;
+    record.pc = pc;
+    record.insn = &d;
+    ThreadEnv<true> env(*this, id, &record);
     try {
         isa::execute(d, h, env);
     } catch (const GuestFault& f) {
@@ -320,9 +324,8 @@ StepRecord Machine::step(uint32_t id) {
     }
     ++t.executed;
     ++counters_.instructions;
-    const AccessRecorder a = env.access();
-    const bool exited = env.exited();
-    return {pc, &d, a.address, a.bytes, a.store, !exited && h.pc != pc + 4, exited};
+    record.taken = !record.exited && h.pc != pc + 4;
+    return record;
 }
 
 } // namespace tpsim::core
