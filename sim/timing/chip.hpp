@@ -9,6 +9,7 @@
 // never depend on host scheduling.
 #pragma once
 #include "isa/isa.hpp"
+#include "sim/core/machine.hpp"
 #include "stats/registry.hpp"
 #include "timing/cache.hpp"
 #include "timing/config.hpp"
@@ -25,16 +26,9 @@
 
 namespace tpsim::timing {
 
-/// What one executed instruction did (mirrors sim/core's StepRecord).
-struct StepInfo {
-    uint32_t pc = 0;
-    const isa::Decoded* insn = nullptr;
-    uint32_t mem_address = 0;
-    uint8_t mem_bytes = 0;  ///< 0 = no memory access
-    bool mem_store = false;
-    bool taken = false;     ///< control left the fall-through path
-    bool exited = false;    ///< the thread ended with this instruction
-};
+/// What one executed instruction did: the functional core's own record, so the machine's
+/// reports reach the chip without a conversion.
+using StepInfo = core::StepRecord;
 
 /// The functional side, as the timing model sees it. Threads are numbered tm * tps_per_tm + tp.
 class InstructionSource {

@@ -24,10 +24,7 @@ public:
 
     uint32_t next_pc(uint32_t thread) const override { return machine_.next_pc(thread); }
 
-    StepInfo step(uint32_t thread) override {
-        const core::StepRecord r = machine_.step(thread);
-        return {r.pc, r.insn, r.mem_address, r.mem_bytes, r.mem_store, r.taken, r.exited};
-    }
+    StepInfo step(uint32_t thread) override { return machine_.step(thread); }
 
 private:
     core::Machine& machine_;
