@@ -29,18 +29,17 @@ template <bool kRecord> class ThreadEnv {
     using Record = std::conditional_t<kRecord, StepRecord*, NoRecorder>;
 
     ThreadEnv(Machine& machine, uint32_t id, Record record = {})
-        : machine_(machine), memory_(machine.memory_), thread_(machine.threads_[id]),
-          h_(thread_.hart), id_(id), local_(machine.memory_.local_store(id).data()),
-          record_(record) {}
+        : machine_(machine), thread_(machine.threads_[id]), id_(id),
+          local_(machine.memory_.local_store(id).data()), record_(record) {}
 
     template <class T> T load(uint32_t addr) {
         if constexpr (kRecord) record_access(addr, sizeof(T), false);
-        return memory_.load<T>(addr, local_);
+        return machine_.memory_.load<T>(addr, local_);
     }
 
     template <class T> void store(uint32_t addr, T value) {
         if constexpr (kRecord) record_access(addr, sizeof(T), true);
-        memory_.store<T>(addr, value, local_);
+        machine_.memory_.store<T>(addr, value, local_);
     }
 
     uint32_t atomic_inc(uint32_t global_register) {
@@ -59,7 +58,7 @@ template <bool kRecord> class ThreadEnv {
         const uint32_t per_tm = m.config_.threads_per_tm;
         // Functionally every instruction takes one cycle, so cycle = instret; the timing model
         // supplies real cycles (set_cycle_counter). (instret itself is the hart's.)
-        const uint64_t cycles = m.cycle_counter_ ? *m.cycle_counter_ : h_.instret;
+        const uint64_t cycles = m.cycle_counter_ ? *m.cycle_counter_ : thread_.hart.instret;
         switch (csr) {
         case c::kMhartid:
             value = id_;
@@ -119,7 +118,7 @@ template <bool kRecord> class ThreadEnv {
     }
 
     void illegal(isa::Hart& h, const isa::Decoded& d) {
-        const uint32_t word = memory_.code_word(h.pc);
+        const uint32_t word = machine_.memory_.code_word(h.pc);
         const Segment* segment = machine_.program_.segment_at(h.pc);
         if (!segment || !segment->executable) machine_.fetch_fault(id_, h.pc);
         if (h.mtvec != 0) return isa::trap(h, kCauseIllegal, word);
@@ -148,9 +147,7 @@ template <bool kRecord> class ThreadEnv {
     }
 
     Machine& machine_;
-    Memory& memory_;
     Thread& thread_;
-    const isa::Hart& h_;
     uint32_t id_;
     uint8_t* local_;
     [[no_unique_address]] Record record_;
