@@ -3,6 +3,7 @@
 // chip.tps_per_tm (machine_config_for() builds a matching one).
 #pragma once
 #include "sim/core/machine.hpp"
+#include "sim/core/thread_env.hpp"
 #include "timing/chip.hpp"
 
 namespace tpsim::timing {
@@ -24,7 +25,7 @@ public:
 
     uint32_t next_pc(uint32_t thread) const override { return machine_.next_pc(thread); }
 
-    StepInfo step(uint32_t thread) override { return machine_.step(thread); }
+    StepInfo step(uint32_t thread) override { return machine_.step_inline(thread); }
 
 private:
     core::Machine& machine_;
