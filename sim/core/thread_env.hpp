@@ -45,12 +45,8 @@ template <bool kRecord> class ThreadEnv {
     }
 
     uint32_t atomic_inc(uint32_t global_register) {
-        if (global_register >= kGlobalRegisters)
-            throw GuestFault{FaultKind::BadGlobalRegister,
-                             fmt::format("uses global register {}, but there are only {} "
-                                         "(0..{})",
-                                         global_register, kGlobalRegisters, kGlobalRegisters - 1),
-                             "use a register index below 256"};
+        if (global_register >= kGlobalRegisters) [[unlikely]]
+            bad_global_register(global_register);
         return machine_.global_registers_[global_register]++;
     }
 
@@ -106,20 +102,18 @@ template <bool kRecord> class ThreadEnv {
             return;
         }
         if (h.mtvec != 0) return isa::trap(h, detail::kCauseEcallM, 0);
-        throw GuestFault{
-            FaultKind::UnsupportedEcall,
-            fmt::format("with a7={}; tpsim only implements exit (a7={})", number, detail::kExitSyscall),
-            "call exit through the kernel runtime, or install a trap handler in "
-            "mtvec"};
+        unsupported_ecall(number);
     }
 
-    void ebreak(isa::Hart&) {
+    // The fault paths are cold and out of line: step_inline is flattened (see there), and they
+    // would only bloat the hot body.
+    [[gnu::cold, gnu::noinline]] void ebreak(isa::Hart&) {
         throw GuestFault{FaultKind::Breakpoint, "stops the thread",
                          "remove the breakpoint (__builtin_trap / ebreak) or fix the failed "
                          "check that reached it"};
     }
 
-    void illegal(isa::Hart& h, const isa::Decoded& d) {
+    [[gnu::cold, gnu::noinline]] void illegal(isa::Hart& h, const isa::Decoded& d) {
         const uint32_t word = machine_.memory_.code_word(h.pc);
         const Segment* segment = machine_.program_.segment_at(h.pc);
         if (!segment || !segment->executable) machine_.fetch_fault(id_, h.pc);
@@ -142,6 +136,21 @@ template <bool kRecord> class ThreadEnv {
     }
 
   private:
+    [[noreturn, gnu::cold, gnu::noinline]] static void bad_global_register(uint32_t index) {
+        throw GuestFault{FaultKind::BadGlobalRegister,
+                         fmt::format("uses global register {}, but there are only {} (0..{})",
+                                     index, kGlobalRegisters, kGlobalRegisters - 1),
+                         "use a register index below 256"};
+    }
+
+    [[noreturn, gnu::cold, gnu::noinline]] static void unsupported_ecall(uint32_t number) {
+        throw GuestFault{FaultKind::UnsupportedEcall,
+                         fmt::format("with a7={}; tpsim only implements exit (a7={})", number,
+                                     detail::kExitSyscall),
+                         "call exit through the kernel runtime, or install a trap handler in "
+                         "mtvec"};
+    }
+
     void record_access(uint32_t addr, uint8_t bytes, bool store) {
         record_->mem_address = addr;
         record_->mem_bytes = bytes;
@@ -156,8 +165,10 @@ template <bool kRecord> class ThreadEnv {
 };
 
 // The timing model's hot path (once per simulated instruction): every check in one unlikely
-// branch, the environment built inline, the fault paths out of line.
-inline StepRecord Machine::step_inline(uint32_t id) {
+// branch, the environment built inline, the fault paths out of line. Flattened: GCC would
+// otherwise keep isa::execute out of line (too big for its inliner), which costs a call and
+// keeps the environment and record in memory instead of registers.
+[[gnu::flatten]] inline StepRecord Machine::step_inline(uint32_t id) {
     // config_.threads, not threads_.size(): no division by sizeof(Thread).
     if (id >= config_.threads) [[unlikely]]
         refuse_step(id);
