@@ -50,7 +50,9 @@ template <bool kRecord> class ThreadEnv {
         return machine_.global_registers_[global_register]++;
     }
 
-    bool read_csr(uint32_t csr, uint32_t& value) {
+    // Out of line: CSR reads are rare, and inlined into the flattened step they only add
+    // register pressure.
+    [[gnu::noinline]] bool read_csr(uint32_t csr, uint32_t& value) {
         namespace c = isa::csr;
         const Machine& m = machine_;
         const uint32_t per_tm = m.config_.threads_per_tm;
