@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "error.hpp"
+#include "isa/csr.hpp"
 #include "thread_env.hpp"
 
 namespace tpsim::core {
@@ -138,6 +139,70 @@ void Machine::run() {
         }
         running.resize(kept);
     }
+}
+
+// Out of line: CSR reads are rare, and inlined into the flattened step they would only add
+// register pressure.
+bool Machine::read_csr(uint32_t id, uint32_t csr, uint32_t& value) const {
+    namespace c = isa::csr;
+    const uint32_t per_tm = config_.threads_per_tm;
+    // Functionally every instruction takes one cycle, so cycle = instret; the timing model
+    // supplies real cycles (set_cycle_counter). (instret itself is the hart's.)
+    const uint64_t cycles = cycle_counter_ ? *cycle_counter_ : threads_[id].hart.instret;
+    switch (csr) {
+    case c::kMhartid:
+        value = id;
+        return true;
+    case c::kNthreads:
+        value = thread_count();
+        return true;
+    case c::kTmid:
+        value = id / per_tm;
+        return true;
+    case c::kNtms:
+        value = (thread_count() + per_tm - 1) / per_tm;
+        return true;
+    case c::kTpid:
+        value = id % per_tm;
+        return true;
+    case c::kTmsize:
+        value = per_tm;
+        return true;
+    case c::kCycle:
+    case c::kMcycle:
+    case c::kTime:
+        value = uint32_t(cycles);
+        return true;
+    case c::kCycleH:
+    case c::kMcycleH:
+    case c::kTimeH:
+        value = uint32_t(cycles >> 32);
+        return true;
+    default:
+        return false;
+    }
+}
+
+void Machine::illegal(uint32_t id, isa::Hart& h, const isa::Decoded& d) {
+    const uint32_t word = memory_.code_word(h.pc);
+    const Segment* segment = program_.segment_at(h.pc);
+    if (!segment || !segment->executable) fetch_fault(id, h.pc);
+    if (h.mtvec != 0) return isa::trap(h, detail::kCauseIllegal, word);
+    if (d.op == isa::Op::Illegal)
+        throw GuestFault{FaultKind::IllegalInstruction,
+                         fmt::format("word {:#010x} is not an RV32IMF instruction", word),
+                         "the pc ran into data, or the program uses an extension tpsim lacks "
+                         "(compile with -march=rv32imf)"};
+    const isa::Format format = isa::info(d.op).format;
+    if (format == isa::Format::Csr || format == isa::Format::CsrImm)
+        throw GuestFault{FaultKind::IllegalInstruction,
+                         fmt::format("accesses CSR {:#05x}, which tpsim does not implement "
+                                     "or which is read-only",
+                                     uint32_t(d.imm)),
+                         "use only the CSRs listed in docs/isa.md"};
+    throw GuestFault{FaultKind::IllegalInstruction,
+                     fmt::format("has no valid rounding mode (frm = {})", h.frm),
+                     "set frm to 0..4 (fsrm) or give the instruction a static rounding mode"};
 }
 
 void Machine::refuse_step(uint32_t id) {

@@ -102,7 +102,10 @@ class Machine {
     [[noreturn]] void fetch_fault(uint32_t id, uint32_t pc);
     [[noreturn]] void limit_fault(uint32_t id);
     [[noreturn]] void refuse_step(uint32_t id);
-    uint32_t read_only_csr(uint32_t id, uint32_t csr, bool& known) const;
+    /// ThreadEnv's out-of-line paths (thread_env.hpp): the CSRs the machine answers (false for
+    /// others), and an illegal or unimplemented instruction (traps to mtvec or throws).
+    bool read_csr(uint32_t id, uint32_t csr, uint32_t& value) const;
+    [[gnu::cold]] void illegal(uint32_t id, isa::Hart& h, const isa::Decoded& d);
 
     Program program_;
     MachineConfig config_;

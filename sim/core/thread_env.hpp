@@ -7,7 +7,6 @@
 
 #include <fmt/format.h>
 
-#include "isa/csr.hpp"
 #include "isa/execute.hpp"
 #include "machine.hpp"
 
@@ -50,48 +49,7 @@ template <bool kRecord> class ThreadEnv {
         return machine_.global_registers_[global_register]++;
     }
 
-    // Out of line: CSR reads are rare, and inlined into the flattened step they only add
-    // register pressure.
-    [[gnu::noinline]] bool read_csr(uint32_t csr, uint32_t& value) {
-        namespace c = isa::csr;
-        const Machine& m = machine_;
-        const uint32_t per_tm = m.config_.threads_per_tm;
-        // Functionally every instruction takes one cycle, so cycle = instret; the timing model
-        // supplies real cycles (set_cycle_counter). (instret itself is the hart's.)
-        const uint64_t cycles = m.cycle_counter_ ? *m.cycle_counter_ : thread_.hart.instret;
-        switch (csr) {
-        case c::kMhartid:
-            value = id_;
-            return true;
-        case c::kNthreads:
-            value = m.thread_count();
-            return true;
-        case c::kTmid:
-            value = id_ / per_tm;
-            return true;
-        case c::kNtms:
-            value = (m.thread_count() + per_tm - 1) / per_tm;
-            return true;
-        case c::kTpid:
-            value = id_ % per_tm;
-            return true;
-        case c::kTmsize:
-            value = per_tm;
-            return true;
-        case c::kCycle:
-        case c::kMcycle:
-        case c::kTime:
-            value = uint32_t(cycles);
-            return true;
-        case c::kCycleH:
-        case c::kMcycleH:
-        case c::kTimeH:
-            value = uint32_t(cycles >> 32);
-            return true;
-        default:
-            return false;
-        }
-    }
+    bool read_csr(uint32_t csr, uint32_t& value) { return machine_.read_csr(id_, csr, value); }
 
     void ecall(isa::Hart& h) {
         const uint32_t number = h.reg[detail::kA7];
@@ -107,35 +65,15 @@ template <bool kRecord> class ThreadEnv {
         unsupported_ecall(number);
     }
 
-    // The fault paths are cold and out of line: step_inline is flattened (see there), and they
-    // would only bloat the hot body.
-    [[gnu::cold, gnu::noinline]] void ebreak(isa::Hart&) {
+    // The rare and fault paths are out of line and take no pointer to the environment, so it
+    // stays in registers in the flattened step (see there).
+    [[noreturn, gnu::cold, gnu::noinline]] static void ebreak(isa::Hart&) {
         throw GuestFault{FaultKind::Breakpoint, "stops the thread",
                          "remove the breakpoint (__builtin_trap / ebreak) or fix the failed "
                          "check that reached it"};
     }
 
-    [[gnu::cold, gnu::noinline]] void illegal(isa::Hart& h, const isa::Decoded& d) {
-        const uint32_t word = machine_.memory_.code_word(h.pc);
-        const Segment* segment = machine_.program_.segment_at(h.pc);
-        if (!segment || !segment->executable) machine_.fetch_fault(id_, h.pc);
-        if (h.mtvec != 0) return isa::trap(h, detail::kCauseIllegal, word);
-        if (d.op == isa::Op::Illegal)
-            throw GuestFault{FaultKind::IllegalInstruction,
-                             fmt::format("word {:#010x} is not an RV32IMF instruction", word),
-                             "the pc ran into data, or the program uses an extension tpsim lacks "
-                             "(compile with -march=rv32imf)"};
-        const isa::Format format = isa::info(d.op).format;
-        if (format == isa::Format::Csr || format == isa::Format::CsrImm)
-            throw GuestFault{FaultKind::IllegalInstruction,
-                             fmt::format("accesses CSR {:#05x}, which tpsim does not implement "
-                                         "or which is read-only",
-                                         uint32_t(d.imm)),
-                             "use only the CSRs listed in docs/isa.md"};
-        throw GuestFault{FaultKind::IllegalInstruction,
-                         fmt::format("has no valid rounding mode (frm = {})", h.frm),
-                         "set frm to 0..4 (fsrm) or give the instruction a static rounding mode"};
-    }
+    void illegal(isa::Hart& h, const isa::Decoded& d) { machine_.illegal(id_, h, d); }
 
   private:
     [[noreturn, gnu::cold, gnu::noinline]] static void bad_global_register(uint32_t index) {
