@@ -2,9 +2,10 @@
 
 #include <catch2/catch.hpp>
 
+#include "documented_stats.hpp"
+
 #include <algorithm>
 #include <deque>
-#include <fstream>
 #include <regex>
 #include <sstream>
 
@@ -227,15 +228,7 @@ TEST_CASE("identical inputs give identical statistics", "[chip][determinism]") {
 }
 
 TEST_CASE("every registered key is documented in docs/statistics.md", "[chip][docs]") {
-    std::ifstream doc(std::string(TPSIM_DOCS_DIR) + "/statistics.md");
-    REQUIRE(doc);
-    // Backticked keys containing '/' become regexes: <placeholder> matches one segment.
-    std::vector<std::regex> documented;
-    const std::regex quoted("`([A-Za-z0-9_<>.-]+/[A-Za-z0-9_<>/.-]+)`");
-    for (std::string line; std::getline(doc, line);)
-        for (std::sregex_iterator m(line.begin(), line.end(), quoted), end; m != end; ++m)
-            documented.emplace_back(
-                std::regex_replace((*m)[1].str(), std::regex("<[^>]+>"), "[^/]+"));
+    const std::vector<std::regex> documented = documented_stat_patterns();
     REQUIRE(documented.size() > 20);
     ChipConfig c;
     c.chip.num_tms = 2;

@@ -7,6 +7,8 @@
 
 #include <catch2/catch.hpp>
 
+#include "documented_stats.hpp"
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -99,15 +101,8 @@ TEST_CASE("timing parameters never change the image", "[render][invariance]") {
 
 TEST_CASE("every key a cycle-level render registers is documented in docs/statistics.md",
           "[render][docs]") {
-    std::ifstream doc(TPSIM_DOCS_DIR "/statistics.md");
-    REQUIRE(doc);
-    // Backticked keys containing '/' become regexes: <placeholder> matches one segment.
-    std::vector<std::regex> documented;
-    const std::regex quoted("`([A-Za-z0-9_<>.-]+/[A-Za-z0-9_<>/.-]+)`");
-    for (std::string line; std::getline(doc, line);)
-        for (std::sregex_iterator m(line.begin(), line.end(), quoted), end; m != end; ++m)
-            documented.emplace_back(
-                std::regex_replace((*m)[1].str(), std::regex("<[^>]+>"), "[^/]+"));
+    const std::vector<std::regex> documented = documented_stat_patterns();
+    REQUIRE(documented.size() > 20);
     const auto result = render_cornell(render::Engine::timing, tiny());
     stats::Registry registry;
     render::register_stats(result, registry);
