@@ -7,6 +7,7 @@
 
 #include "native_twin.hpp"
 #include "timing_run.hpp"
+#include "sim/timing/machine_source.hpp"
 #include "sim/core/elf_loader.hpp"
 #include "sim/core/error.hpp"
 #include "sim/core/machine.hpp"
@@ -22,26 +23,26 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 /// Runs the kernel ELF on the functional machine over the image, in place.
 InstructionCounts run_functional(const std::filesystem::path& kernel, image::MemoryImage& image,
                                  const timing::ChipConfig& chip, uint64_t max_instructions) {
-    core::MachineConfig config;
-    config.threads = chip.chip.num_tms * chip.chip.tps_per_tm;
-    config.threads_per_tm = chip.chip.tps_per_tm;
-    config.local_store_bytes = chip.tp.local_store_bytes;
+    core::MachineConfig config = timing::machine_config_for(chip);
     config.global_bytes = uint32_t(image.bytes());
     config.max_instructions = max_instructions;
     core::Machine machine(core::load_elf(kernel), config);
     std::memcpy(machine.memory().global().data(), image.words.data(), image.bytes());
     machine.run();
     std::memcpy(image.words.data(), machine.memory().global().data(), image.bytes());
+    return InstructionCounts::of(machine.counters());
+}
 
+}  // namespace
+
+InstructionCounts InstructionCounts::of(const core::Counters& counters) {
     InstructionCounts counts;
-    counts.total = machine.counters().instructions;
-    counts.per_op = machine.counters().per_op;
+    counts.total = counters.instructions;
+    counts.per_op = counters.per_op;
     for (size_t op = 0; op < counts.per_op.size(); ++op)
         counts.per_fu[size_t(isa::info(isa::Op(op)).fu)] += counts.per_op[op];
     return counts;
 }
-
-}  // namespace
 
 bool kernel_uses_bvh(const std::filesystem::path& kernel_elf) {
     const core::Program program = core::load_elf(kernel_elf.string());

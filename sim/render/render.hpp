@@ -15,6 +15,10 @@
 #include "sim/scene/scene.hpp"
 #include "sim/timing/config.hpp"
 
+namespace tpsim::core {
+struct Counters;
+}
+
 namespace tpsim::render {
 
 enum class Engine {
@@ -53,6 +57,9 @@ struct InstructionCounts {
     uint64_t total = 0;
     std::array<uint64_t, size_t(isa::Op::Count)> per_op{};
     std::array<uint64_t, size_t(isa::FuClass::Count)> per_fu{};
+
+    /// A machine's counts, with the per-FU-class totals derived from the per-opcode ones.
+    static InstructionCounts of(const core::Counters& counters);
 };
 
 struct RenderResult {

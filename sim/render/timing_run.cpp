@@ -31,11 +31,7 @@ std::shared_ptr<TimingRun> run_timing(const std::filesystem::path& kernel_elf,
     run->chip->run(UINT64_MAX, hook);
     std::memcpy(image.words.data(), machine.memory().global().data(), image.bytes());
 
-    InstructionCounts& counts = run->instructions;
-    counts.total = machine.counters().instructions;
-    counts.per_op = machine.counters().per_op;
-    for (size_t op = 0; op < counts.per_op.size(); ++op)
-        counts.per_fu[size_t(isa::info(isa::Op(op)).fu)] += counts.per_op[op];
+    run->instructions = InstructionCounts::of(machine.counters());
     return run;
 }
 
