@@ -216,6 +216,10 @@ void Machine::refuse_step(uint32_t id) {
     limit_fault(id);
 }
 
-StepRecord Machine::step(uint32_t id) { return step_inline(id); }
+StepRecord Machine::step(uint32_t id) {
+    StepRecord record;
+    step_inline(id, record);
+    return record;
+}
 
 } // namespace tpsim::core

@@ -74,8 +74,9 @@ class Machine {
 
     /// Executes one instruction of a running thread and reports what it did. Throws Fault.
     StepRecord step(uint32_t thread);
-    /// step(), defined in thread_env.hpp so the timing model's cycle loop can inline it.
-    inline StepRecord step_inline(uint32_t thread);
+    /// step() into `record`, defined in thread_env.hpp so the timing model's cycle loop can
+    /// inline it and the record lands where the caller keeps it (no copy).
+    inline void step_inline(uint32_t thread, StepRecord& record);
 
     /// Timing mode: the cycle/time CSRs read `*cycles` (the chip's current cycle) instead of
     /// instret; nullptr (the default) = functional mode, where cycle = instret. The counter

@@ -108,7 +108,7 @@ template <bool kRecord> class ThreadEnv {
 // branch, the environment built inline, the fault paths out of line. Flattened: GCC would
 // otherwise keep isa::execute out of line (too big for its inliner), which costs a call and
 // keeps the environment and record in memory instead of registers.
-[[gnu::flatten]] inline StepRecord Machine::step_inline(uint32_t id) {
+[[gnu::flatten]] inline void Machine::step_inline(uint32_t id, StepRecord& record) {
     // config_.threads, not threads_.size(): no division by sizeof(Thread).
     if (id >= config_.threads) [[unlikely]]
         refuse_step(id);
@@ -122,9 +122,7 @@ template <bool kRecord> class ThreadEnv {
         fetch_fault(id, pc);
     const isa::Decoded& d = decoded_[index];
     ++counters_.per_op[size_t(d.op)];
-    StepRecord record;
-    record.pc = pc;
-    record.insn = &d;
+    record = StepRecord{.pc = pc, .insn = &d};
     ThreadEnv<true> env(*this, id, &record);
     try {
         isa::execute(d, h, env);
@@ -134,7 +132,6 @@ template <bool kRecord> class ThreadEnv {
     ++t.executed;
     ++counters_.instructions;
     record.taken = !record.exited && h.pc != pc + 4;
-    return record;
 }
 
 } // namespace tpsim::core

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <utility>
 #include <stdexcept>
 
 namespace tpsim::timing {
@@ -48,27 +49,23 @@ void for_each_bit_from(const std::vector<uint64_t>& bits, uint32_t start, F&& f)
 
 struct Chip::Tm {
     struct Tp {
+        // The fields a visit reads first, together; the register file last.
+        uint64_t wake_at = 0;        // asleep until this cycle (kNever: until a reply for it)
+        StepInfo pending;            // fetched, not yet issued
+        bool has_pending = false;
+        bool mem_waiting = false;    // a granted load/store waits for its L1 access from mem_at
+        Pool pending_pool{};
+        isa::FuClass pending_class{};
+        std::array<uint8_t, 4> pending_regs{};  // rs1, rs2, rs3, rd; kNoReg as kNumRegs
+        Pool asleep_on{};            // the producing pool a kNever sleep is attributed to
+        uint64_t asleep_from = 0;    // first uncounted cycle of a kNever sleep
+        uint64_t mem_at = 0;
+        MemRequest mem_request;
+        uint32_t lowest_local = trax::map::kLocalTop;  // for the local-store high-water mark
         // Cycle each register becomes readable; the extra last slot stands for kNoReg (an
         // unused operand) and stays 0, so the scoreboard check needs no branch per operand.
         std::array<uint64_t, isa::kNumRegs + 1> reg_ready{};
         std::array<Pool, isa::kNumRegs> reg_producer{};   // pool that will write it
-        StepInfo pending;            // fetched, not yet issued
-        isa::FuClass pending_class{};
-        Pool pending_pool{};
-        std::array<uint8_t, 4> pending_regs{};  // rs1, rs2, rs3, rd; kNoReg as kNumRegs
-        bool has_pending = false;
-        bool done = false;
-        uint64_t fetch_at = 0;       // earliest cycle of the next fetch (branch bubbles)
-        // Operand waits are not re-checked every cycle: the TP sleeps until wake_at (kNever:
-        // until a memory or atomic reply for it arrives), its stall cycles counted in bulk.
-        uint64_t wake_at = 0;
-        uint64_t asleep_from = 0;    // first uncounted cycle of a kNever sleep
-        Pool asleep_on{};            // the producing pool the sleep is attributed to
-        // A granted load/store waiting for its L1 access, from cycle mem_at.
-        bool mem_waiting = false;
-        uint64_t mem_at = 0;
-        MemRequest mem_request;
-        uint32_t lowest_local = trax::map::kLocalTop;  // for the local-store high-water mark
     };
     struct Counters {
         uint64_t instructions = 0;
@@ -81,8 +78,9 @@ struct Chip::Tm {
     };
 
     Tm(const ChipConfig& c, uint32_t id)
-        : id(id), tps(c.chip.tps_per_tm), icache(c.icache, c.chip.tps_per_tm), l1(c.l1),
-          mem_waiting_tps((c.chip.tps_per_tm + 63) / 64), awake_tps(mem_waiting_tps.size()) {
+        : id(id), words((c.chip.tps_per_tm + 63) / 64), tps(c.chip.tps_per_tm),
+          icache(c.icache, c.chip.tps_per_tm), l1(c.l1), mem_waiting_tps(words),
+          awake_tps(words), wheel(size_t{kWheelSlots} * words) {
         for (uint32_t i = 0; i < c.chip.tps_per_tm; ++i) set_bit(awake_tps, i);
         for (size_t p = 0; p < kPools; ++p)
             pools.emplace_back(pool_config(c.fu, Pool(p)), c.chip.tps_per_tm);
@@ -101,8 +99,25 @@ struct Chip::Tm {
         add_operand_stalls(tp.asleep_on, now - tp.asleep_from);
         tp.wake_at = now;
     }
+    /// TP i leaves the awake set until cycle `at` (> now), when the wheel puts it back. A wait
+    /// beyond the wheel comes back early and is put to sleep again by its visit.
+    void sleep_until(uint32_t i, uint64_t at, uint64_t now) {
+        tps[i].wake_at = at;
+        clear_bit(awake_tps, i);
+        const uint64_t slot = (at - now < kWheelSlots ? at : now + kWheelSlots - 1) % kWheelSlots;
+        wheel[slot * words + (i >> 6)] |= uint64_t{1} << (i & 63);
+    }
+    /// Start of cycle `now`: the TPs whose timed sleep ends join the awake set.
+    void wake_timed(uint64_t now) {
+        uint64_t* slot = &wheel[(now % kWheelSlots) * words];
+        for (uint32_t w = 0; w < words; ++w) awake_tps[w] |= std::exchange(slot[w], 0);
+    }
+
+    // Timed sleeps (operand latencies, branch bubbles) wait in a wheel of this many cycles.
+    static constexpr uint32_t kWheelSlots = 64;
 
     uint32_t id;
+    uint32_t words;               // 64-bit words of a bit set over the TPs
     std::vector<Tp> tps;
     std::vector<FuPool> pools;
     ICacheBanks icache;
@@ -112,9 +127,10 @@ struct Chip::Tm {
     std::vector<AtomicRequest> atomics_out;  // sent this cycle, collected by the chip
     uint32_t running = 0;
     std::vector<uint64_t> mem_waiting_tps;  // bit per TP with mem_waiting set
-    // Bit per TP that is neither done nor asleep until a reply (wake_at == kNever): the TP
-    // loop visits only these.
+    // Bit per TP the TP loop visits: not done, not asleep (timed sleepers are in the wheel,
+    // those waiting for a reply return through wake()).
     std::vector<uint64_t> awake_tps;
+    std::vector<uint64_t> wheel;            // kWheelSlots bit sets, slot = wake cycle % slots
     Counters counters;
 };
 
@@ -256,10 +272,12 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
 
     // Fetch, scoreboard check, FU request. Base pointers in locals: the loop's byte-sized
     // stores could alias the vectors' internals, which would make the compiler reload them.
+    tm.wake_timed(now);
     Tm::Tp* const tps = tm.tps.data();
     const uint32_t first_thread = tm.id * n;
+    uint32_t requested_pools = 0;  // bit per pool with a request this cycle
     // Awake TPs in rotating order, as for_each_bit_from, spelled out so the body stays inline.
-    const uint32_t words = static_cast<uint32_t>(tm.awake_tps.size());
+    const uint32_t words = tm.words;
     const uint32_t first_word = tm.rotation >> 6;
     const uint64_t below_start = (uint64_t{1} << (tm.rotation & 63)) - 1;
     for (uint32_t k = 0, w = first_word; k <= words; ++k, w = w + 1 == words ? 0 : w + 1) {
@@ -269,19 +287,18 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
         for (; bits != 0; bits &= bits - 1) {
             const uint32_t i = (w << 6) + static_cast<uint32_t>(std::countr_zero(bits));
             Tm::Tp& tp = tps[i];
-            if (now < tp.wake_at) continue;  // asleep until a known cycle
+            if (now < tp.wake_at) [[unlikely]] {  // back early from a wait beyond the wheel
+                tm.sleep_until(i, tp.wake_at, now);
+                continue;
+            }
             ++tm.counters.active_tp_cycles;
             if (!tp.has_pending) {
-                if (now < tp.fetch_at) {
-                    ++tm.counters.stalls[size_t(Stall::Branch)];
-                    continue;
-                }
                 const uint32_t thread = first_thread + i;
                 if (!tm.icache.fetch(now, i, source.next_pc(thread))) {
                     ++tm.counters.stalls[size_t(Stall::FetchConflict)];
                     continue;
                 }
-                tp.pending = source.step(thread);
+                source.step(thread, tp.pending);
                 const isa::Decoded& d = *tp.pending.insn;
                 tp.pending_class = class_of_[size_t(d.op)];
                 tp.pending_pool = pool_of_[size_t(d.op)];
@@ -290,14 +307,13 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
                                    std::min(d.rs3, isa::kNumRegs), std::min(d.rd, isa::kNumRegs)};
                 tp.has_pending = true;
             }
-            const isa::Decoded& d = *tp.pending.insn;
             const auto ready_at = [&](size_t slot) { return tp.reg_ready[tp.pending_regs[slot]]; };
             const uint64_t operands_at =
                 std::max(std::max(ready_at(0), ready_at(1)), std::max(ready_at(2), ready_at(3)));
             if (operands_at > now) {
                 Pool blocking = Pool::IntAlu;  // producer of the first operand that is ready last
-                for (uint8_t r : {d.rs1, d.rs2, d.rs3, d.rd})
-                    if (r != isa::kNoReg && tp.reg_ready[r] == operands_at) {
+                for (uint8_t r : tp.pending_regs)
+                    if (r != isa::kNumRegs && tp.reg_ready[r] == operands_at) {
                         blocking = tp.reg_producer[r];
                         break;
                     }
@@ -305,13 +321,14 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
                 ++tm.counters.operand_stalls[size_t(blocking)];
                 // Nothing can change this wait before operands_at but a reply for this TP, which
                 // wakes it; so the cycles in between are operand stalls on `blocking`.
-                tp.wake_at = operands_at;
                 if (operands_at == kNever) {
+                    tp.wake_at = kNever;
                     clear_bit(tm.awake_tps, i);
                     tp.asleep_from = now + 1;
                     tp.asleep_on = blocking;
                 } else {
                     tm.add_operand_stalls(blocking, operands_at - now - 1);
+                    tm.sleep_until(i, operands_at, now);
                 }
                 continue;
             }
@@ -321,11 +338,13 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
                 continue;
             }
             tm.pools[size_t(pool)].request(i);
+            requested_pools |= 1u << size_t(pool);
         }
     }
 
     // Requests the pools refuse are the FU-busy stalls (the TP keeps its instruction).
-    for (size_t p = 0; p < kPools; ++p) {
+    for (; requested_pools != 0; requested_pools &= requested_pools - 1) {
+        const auto p = static_cast<size_t>(std::countr_zero(requested_pools));
         const Pool pool = Pool(p);
         tm.counters.stalls[size_t(Stall::FuBusy)] += tm.pools[p].arbitrate(now, [&](uint32_t i, uint64_t ready) {
             Tm::Tp& tp = tm.tps[i];
@@ -354,16 +373,19 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
                 tp.reg_ready[d.rd] = result_at;
                 tp.reg_producer[d.rd] = pool;
             }
-            const uint32_t bubble = fu == isa::FuClass::Branch
-                                        ? (s.taken ? config_.tp.branch_taken_penalty
-                                                   : config_.tp.branch_not_taken_penalty)
-                                        : 0;
-            tp.fetch_at = now + 1 + bubble;
             tp.has_pending = false;
             if (s.exited) {
-                tp.done = true;
                 clear_bit(tm.awake_tps, i);
                 --tm.running;
+            } else if (fu == isa::FuClass::Branch) {
+                // The bubble after a branch: no fetch before now + 1 + bubble.
+                const uint32_t bubble = s.taken ? config_.tp.branch_taken_penalty
+                                                : config_.tp.branch_not_taken_penalty;
+                if (bubble != 0) {
+                    tm.counters.active_tp_cycles += bubble;
+                    tm.counters.stalls[size_t(Stall::Branch)] += bubble;
+                    tm.sleep_until(i, now + 1 + bubble, now);
+                }
             }
         });
     }

@@ -36,8 +36,8 @@ public:
     virtual ~InstructionSource() = default;
     /// Address of the next instruction thread `thread` will execute.
     virtual uint32_t next_pc(uint32_t thread) const = 0;
-    /// Executes that instruction and reports it.
-    virtual StepInfo step(uint32_t thread) = 0;
+    /// Executes that instruction and reports it in `out` (every field written).
+    virtual void step(uint32_t thread, StepInfo& out) = 0;
 };
 
 /// Why a TP did not issue in a cycle (exactly one cause per TP-cycle).

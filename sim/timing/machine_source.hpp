@@ -25,7 +25,7 @@ public:
 
     uint32_t next_pc(uint32_t thread) const override { return machine_.next_pc(thread); }
 
-    StepInfo step(uint32_t thread) override { return machine_.step_inline(thread); }
+    void step(uint32_t thread, StepInfo& out) override { machine_.step_inline(thread, out); }
 
 private:
     core::Machine& machine_;

@@ -50,7 +50,7 @@ public:
         return *this;
     }
     uint32_t next_pc(uint32_t thread) const override { return trace_[thread][next_[thread]].pc; }
-    StepInfo step(uint32_t thread) override { return trace_[thread].at(next_[thread]++); }
+    void step(uint32_t thread, StepInfo& out) override { out = trace_[thread].at(next_[thread]++); }
 
 private:
     std::deque<Decoded> decoded_;  // stable addresses
