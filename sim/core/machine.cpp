@@ -35,6 +35,16 @@ Machine::Machine(Program program, const MachineConfig& config)
     decoded_.reserve(text_bytes_ / 4);
     for (uint32_t addr = lo; addr - lo < text_bytes_; addr += 4)
         decoded_.push_back(isa::decode(memory_.code_word(addr)));
+    privacy_.reserve(decoded_.size());
+    for (const isa::Decoded& d : decoded_) {
+        switch (isa::info(d.op).fu) {
+        case isa::FuClass::Load:
+        case isa::FuClass::Store: privacy_.push_back(Privacy::IfLocal); break;
+        case isa::FuClass::Atomic:
+        case isa::FuClass::System: privacy_.push_back(Privacy::Never); break;
+        default: privacy_.push_back(Privacy::Always); break;
+        }
+    }
 
     threads_.resize(config_.threads);
     for (Thread& t : threads_) {

@@ -78,6 +78,13 @@ class Machine {
     /// inline it and the record lands where the caller keeps it (no copy).
     inline void step_inline(uint32_t thread, StepRecord& record);
 
+    /// True if thread `id` is running and its next instruction touches only the thread's own
+    /// state (registers, pc, local store): executing it earlier or later than other threads'
+    /// instructions cannot change any result. False for shared-memory accesses, atomics and
+    /// CSR/system instructions (whose results may depend on when they run). Defined in
+    /// thread_env.hpp.
+    inline bool next_is_private(uint32_t id) const;
+
     /// Timing mode: the cycle/time CSRs read `*cycles` (the chip's current cycle) instead of
     /// instret; nullptr (the default) = functional mode, where cycle = instret. The counter
     /// must outlive the instructions that read it.
@@ -114,6 +121,10 @@ class Machine {
     uint32_t text_base_ = 0;
     uint32_t text_bytes_ = 0;
     std::vector<isa::Decoded> decoded_; ///< the executable range, one entry per word
+    /// Per word of decoded_: whether the instruction is private (next_is_private), always,
+    /// never, or if its load/store address is in the local store.
+    enum class Privacy : uint8_t { Always, Never, IfLocal };
+    std::vector<Privacy> privacy_;
     std::vector<Thread> threads_;
     std::array<uint32_t, kGlobalRegisters> global_registers_{};
     Counters counters_;

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "isa/execute.hpp"
+#include "kernel/memory_map.hpp"
 #include "machine.hpp"
 
 namespace tpsim::core {
@@ -132,6 +133,21 @@ template <bool kRecord> class ThreadEnv {
     ++t.executed;
     ++counters_.instructions;
     record.taken = !record.exited && h.pc != pc + 4;
+}
+
+inline bool Machine::next_is_private(uint32_t id) const {
+    const Thread& t = threads_[id];
+    const uint32_t index = std::rotr(t.hart.pc - text_base_, 2);
+    if (t.state != ThreadState::Running || index >= text_bytes_ / 4) return false;
+    switch (privacy_[index]) {
+    case Privacy::Always: return true;
+    case Privacy::Never: return false;
+    case Privacy::IfLocal: break;
+    }
+    // The local store, its overflow guard and the unmapped space above are private: an access
+    // there either touches the thread's own store or faults.
+    const isa::Decoded& d = decoded_[index];
+    return t.hart.reg[d.rs1] + uint32_t(d.imm) >= trax::map::kLocalTop - trax::map::kStackGuard;
 }
 
 } // namespace tpsim::core

@@ -112,13 +112,13 @@ public:
         const uint32_t word = pc / 4;
         const uint32_t in_icache = bank_mask_ ? word & bank_mask_ : word % banks_per_icache_;
         Bank& bank = banks_[first_bank_[tp] + in_icache];
-        if (bank.cycle == now && bank.pc != pc) {
-            ++counters_.conflicts;
-            return false;
-        }
-        bank = {now, pc};
-        ++counters_.fetches;
-        return true;
+        // Written without branches: whether a fetch conflicts is unpredictable for the host.
+        const bool granted = bank.cycle != now || bank.pc == pc;
+        bank.cycle = now;
+        bank.pc = granted ? pc : bank.pc;
+        counters_.conflicts += !granted;
+        counters_.fetches += granted;
+        return granted;
     }
 
     const Counters& counters() const { return counters_; }

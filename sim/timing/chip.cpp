@@ -26,40 +26,51 @@ void clear_bit(std::vector<uint64_t>& bits, uint32_t i) {
     bits[i >> 6] &= ~(uint64_t{1} << (i & 63));
 }
 
-/// Calls f(i) for every set bit i of `bits` in rotating order: start, start + 1, ..., wrapping
-/// to 0 (the order of the TP loops, without visiting the clear bits).
+/// Calls f(word_index, mask) so that the masks' bits, taken in order, visit every bit index in
+/// rotating order: start, start + 1, ..., wrapping to 0. The first word comes twice: its bits
+/// from `start` up first, the ones below last.
 template <class F>
-void for_each_bit_from(const std::vector<uint64_t>& bits, uint32_t start, F&& f) {
-    const auto visit = [&](uint32_t w, uint64_t word) {
-        for (; word != 0; word &= word - 1)
-            f((w << 6) + static_cast<uint32_t>(std::countr_zero(word)));
-    };
-    const uint32_t words = static_cast<uint32_t>(bits.size());
+void for_each_rotated_part(uint32_t words, uint32_t start, F&& f) {
     const uint32_t first_word = start >> 6;
     const uint64_t below_start = (uint64_t{1} << (start & 63)) - 1;
-    visit(first_word, bits[first_word] & ~below_start);
+    f(first_word, ~below_start);
     for (uint32_t k = 1, w = first_word; k < words; ++k) {
         w = w + 1 == words ? 0 : w + 1;
-        visit(w, bits[w]);
+        f(w, ~uint64_t{0});
     }
-    visit(first_word, bits[first_word] & below_start);
+    f(first_word, below_start);
+}
+
+/// Calls f(i) for each set bit of `word`, lowest first; i counts from bit 0 of word `w`.
+template <class F>
+void for_each_bit(uint32_t w, uint64_t word, F&& f) {
+    for (; word != 0; word &= word - 1) f((w << 6) + static_cast<uint32_t>(std::countr_zero(word)));
+}
+
+/// The longest a TP can sleep until a known cycle: an operand wait (at most the longest FU
+/// latency plus the local-store latency) or a branch bubble.
+uint64_t longest_timed_sleep(const ChipConfig& c) {
+    uint64_t fu = 0;
+    for (size_t p = 0; p < kPools; ++p) fu = std::max<uint64_t>(fu, pool_config(c.fu, Pool(p)).latency);
+    const uint64_t bubble = std::max(c.tp.branch_taken_penalty, c.tp.branch_not_taken_penalty);
+    return std::max(fu + c.tp.local_store_latency, bubble + 1);
 }
 
 }  // namespace
 
 struct Chip::Tm {
+    // Per-TP flags the cycle loop tests for many TPs at once are bit sets over the TPs (bit
+    // i of word i / 64); the rest of a TP's state is in Tp.
+    using TpBits = std::vector<uint64_t>;
     struct Tp {
-        // The fields a visit reads first, together; the register file last.
-        uint64_t wake_at = 0;        // asleep until this cycle (kNever: until a reply for it)
-        StepInfo pending;            // fetched, not yet issued
-        bool has_pending = false;
-        bool mem_waiting = false;    // a granted load/store waits for its L1 access from mem_at
+        StepInfo pending;            // fetched, not yet issued (bit in pending_tps)
         Pool pending_pool{};
         isa::FuClass pending_class{};
         std::array<uint8_t, 4> pending_regs{};  // rs1, rs2, rs3, rd; kNoReg as kNumRegs
-        Pool asleep_on{};            // the producing pool a kNever sleep is attributed to
-        uint64_t asleep_from = 0;    // first uncounted cycle of a kNever sleep
-        uint64_t mem_at = 0;
+        Pool asleep_on{};            // the producing pool a reply-wait is attributed to
+        uint64_t wake_at = 0;        // asleep until this cycle (kNever: until a reply for it)
+        uint64_t asleep_from = 0;    // first uncounted cycle of a reply-wait
+        uint64_t mem_at = 0;         // a granted load/store's first cycle at the L1
         MemRequest mem_request;
         uint32_t lowest_local = trax::map::kLocalTop;  // for the local-store high-water mark
         // Cycle each register becomes readable; the extra last slot stands for kNoReg (an
@@ -79,8 +90,9 @@ struct Chip::Tm {
 
     Tm(const ChipConfig& c, uint32_t id)
         : id(id), words((c.chip.tps_per_tm + 63) / 64), tps(c.chip.tps_per_tm),
-          icache(c.icache, c.chip.tps_per_tm), l1(c.l1), mem_waiting_tps(words),
-          awake_tps(words), wheel(size_t{kWheelSlots} * words) {
+          icache(c.icache, c.chip.tps_per_tm), l1(c.l1), awake_tps(words), pending_tps(words),
+          needs_port_tps(words), mem_waiting_tps(words),
+          wheel_slots(std::bit_ceil(longest_timed_sleep(c) + 1)), wheel(wheel_slots * words) {
         for (uint32_t i = 0; i < c.chip.tps_per_tm; ++i) set_bit(awake_tps, i);
         for (size_t p = 0; p < kPools; ++p)
             pools.emplace_back(pool_config(c.fu, Pool(p)), c.chip.tps_per_tm);
@@ -99,25 +111,21 @@ struct Chip::Tm {
         add_operand_stalls(tp.asleep_on, now - tp.asleep_from);
         tp.wake_at = now;
     }
-    /// TP i leaves the awake set until cycle `at` (> now), when the wheel puts it back. A wait
-    /// beyond the wheel comes back early and is put to sleep again by its visit.
-    void sleep_until(uint32_t i, uint64_t at, uint64_t now) {
+    /// TP i leaves the awake set until cycle `at` (now < at <= now + longest_timed_sleep),
+    /// when the wheel puts it back.
+    void sleep_until(uint32_t i, uint64_t at) {
         tps[i].wake_at = at;
         clear_bit(awake_tps, i);
-        const uint64_t slot = (at - now < kWheelSlots ? at : now + kWheelSlots - 1) % kWheelSlots;
-        wheel[slot * words + (i >> 6)] |= uint64_t{1} << (i & 63);
+        set_bit(wheel, uint32_t(at & (wheel_slots - 1)) * 64 * words + i);
     }
     /// Start of cycle `now`: the TPs whose timed sleep ends join the awake set.
     void wake_timed(uint64_t now) {
-        uint64_t* slot = &wheel[(now % kWheelSlots) * words];
+        uint64_t* slot = &wheel[(now & (wheel_slots - 1)) * words];
         for (uint32_t w = 0; w < words; ++w) awake_tps[w] |= std::exchange(slot[w], 0);
     }
 
-    // Timed sleeps (operand latencies, branch bubbles) wait in a wheel of this many cycles.
-    static constexpr uint32_t kWheelSlots = 64;
-
     uint32_t id;
-    uint32_t words;               // 64-bit words of a bit set over the TPs
+    uint32_t words;               // 64-bit words of a TpBits
     std::vector<Tp> tps;
     std::vector<FuPool> pools;
     ICacheBanks icache;
@@ -126,11 +134,16 @@ struct Chip::Tm {
     uint32_t atomic_sequence = 0;
     std::vector<AtomicRequest> atomics_out;  // sent this cycle, collected by the chip
     uint32_t running = 0;
-    std::vector<uint64_t> mem_waiting_tps;  // bit per TP with mem_waiting set
-    // Bit per TP the TP loop visits: not done, not asleep (timed sleepers are in the wheel,
-    // those waiting for a reply return through wake()).
-    std::vector<uint64_t> awake_tps;
-    std::vector<uint64_t> wheel;            // kWheelSlots bit sets, slot = wake cycle % slots
+    // Visited by the cycle loop: not exited, not asleep (timed sleepers wait in the wheel,
+    // reply-waits return through wake()).
+    TpBits awake_tps;
+    TpBits pending_tps;      // holding a fetched instruction
+    TpBits needs_port_tps;   // ... that is a load/store to global memory (needs the L1 port)
+    TpBits mem_waiting_tps;  // a granted load/store waits for its L1 access
+    // Timed sleeps: wheel_slots TpBits (a power of two above the longest sleep), the one for
+    // cycle t at t % wheel_slots.
+    uint64_t wheel_slots;
+    TpBits wheel;
     Counters counters;
 };
 
@@ -261,98 +274,105 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
     if (tm.running == 0) return;
 
     // Granted loads/stores take their L1 bank in rotating order.
-    for_each_bit_from(tm.mem_waiting_tps, tm.rotation, [&](uint32_t i) {
-        Tm::Tp& tp = tm.tps[i];
-        if (tp.mem_at > now) return;
-        if (accepted(tm.l1.access(now, tp.mem_request))) {
-            tp.mem_waiting = false;
-            clear_bit(tm.mem_waiting_tps, i);
-        }
+    for_each_rotated_part(tm.words, tm.rotation, [&](uint32_t w, uint64_t part) {
+        for_each_bit(w, tm.mem_waiting_tps[w] & part, [&](uint32_t i) {
+            Tm::Tp& tp = tm.tps[i];
+            if (tp.mem_at <= now && accepted(tm.l1.access(now, tp.mem_request)))
+                clear_bit(tm.mem_waiting_tps, i);
+        });
     });
 
-    // Fetch, scoreboard check, FU request. Base pointers in locals: the loop's byte-sized
-    // stores could alias the vectors' internals, which would make the compiler reload them.
+    // Every awake TP, in rotating order: fetch if it holds no instruction, check the
+    // scoreboard, request a unit. Done in passes over bit sets, each pass a short loop with
+    // few data-dependent branches; only fetch (I-cache banks, and the functional step, whose
+    // shared-memory effects must happen in fetch order) depends on the order.
     tm.wake_timed(now);
     Tm::Tp* const tps = tm.tps.data();
     const uint32_t first_thread = tm.id * n;
     uint32_t requested_pools = 0;  // bit per pool with a request this cycle
-    // Awake TPs in rotating order, as for_each_bit_from, spelled out so the body stays inline.
-    const uint32_t words = tm.words;
-    const uint32_t first_word = tm.rotation >> 6;
-    const uint64_t below_start = (uint64_t{1} << (tm.rotation & 63)) - 1;
-    for (uint32_t k = 0, w = first_word; k <= words; ++k, w = w + 1 == words ? 0 : w + 1) {
-        // The first word twice: its bits from the rotation up, last the ones below.
-        const uint64_t part = k == 0 ? ~below_start : k == words ? below_start : ~uint64_t{0};
-        uint64_t bits = tm.awake_tps[w] & part;
-        for (; bits != 0; bits &= bits - 1) {
-            const uint32_t i = (w << 6) + static_cast<uint32_t>(std::countr_zero(bits));
+    auto& counters = tm.counters;
+    for_each_rotated_part(tm.words, tm.rotation, [&](uint32_t w, uint64_t part) {
+        const uint64_t visiting = tm.awake_tps[w] & part;
+        counters.active_tp_cycles += std::popcount(visiting);
+
+        const uint64_t fetching = visiting & ~tm.pending_tps[w];
+        uint64_t fetched = 0;
+        for_each_bit(w, fetching, [&](uint32_t i) {
+            fetched |= uint64_t{tm.icache.fetch(now, i, source.next_pc(first_thread + i))} << (i & 63);
+        });
+        counters.stalls[size_t(Stall::FetchConflict)] += std::popcount(fetching & ~fetched);
+        for_each_bit(w, fetched, [&](uint32_t i) {
             Tm::Tp& tp = tps[i];
-            if (now < tp.wake_at) [[unlikely]] {  // back early from a wait beyond the wheel
-                tm.sleep_until(i, tp.wake_at, now);
-                continue;
-            }
-            ++tm.counters.active_tp_cycles;
-            if (!tp.has_pending) {
-                const uint32_t thread = first_thread + i;
-                if (!tm.icache.fetch(now, i, source.next_pc(thread))) {
-                    ++tm.counters.stalls[size_t(Stall::FetchConflict)];
-                    continue;
-                }
-                source.step(thread, tp.pending);
-                const isa::Decoded& d = *tp.pending.insn;
-                tp.pending_class = class_of_[size_t(d.op)];
-                tp.pending_pool = pool_of_[size_t(d.op)];
-                // rd too: no write-after-write reorder. kNoReg maps to the always-ready last slot.
-                tp.pending_regs = {std::min(d.rs1, isa::kNumRegs), std::min(d.rs2, isa::kNumRegs),
-                                   std::min(d.rs3, isa::kNumRegs), std::min(d.rd, isa::kNumRegs)};
-                tp.has_pending = true;
-            }
+            source.step(first_thread + i, tp.pending);
+            const isa::Decoded& d = *tp.pending.insn;
+            tp.pending_class = class_of_[size_t(d.op)];
+            tp.pending_pool = pool_of_[size_t(d.op)];
+            // rd too: no write-after-write reorder. kNoReg maps to the always-ready last slot.
+            tp.pending_regs = {std::min(d.rs1, isa::kNumRegs), std::min(d.rs2, isa::kNumRegs),
+                               std::min(d.rs3, isa::kNumRegs), std::min(d.rd, isa::kNumRegs)};
+            const bool needs_port =
+                tp.pending_pool == Pool::LoadStore && !is_local(tp.pending.mem_address);
+            tm.needs_port_tps[w] |= uint64_t{needs_port} << (i & 63);
+        });
+        tm.pending_tps[w] |= fetched;
+
+        // Scoreboard: ready when every operand (and rd: no write-after-write reorder) is.
+        const uint64_t holding = visiting & tm.pending_tps[w];
+        uint64_t ready = 0;
+        for_each_bit(w, holding, [&](uint32_t i) {
+            const Tm::Tp& tp = tps[i];
             const auto ready_at = [&](size_t slot) { return tp.reg_ready[tp.pending_regs[slot]]; };
             const uint64_t operands_at =
                 std::max(std::max(ready_at(0), ready_at(1)), std::max(ready_at(2), ready_at(3)));
-            if (operands_at > now) {
-                Pool blocking = Pool::IntAlu;  // producer of the first operand that is ready last
-                for (uint8_t r : tp.pending_regs)
-                    if (r != isa::kNumRegs && tp.reg_ready[r] == operands_at) {
-                        blocking = tp.reg_producer[r];
-                        break;
-                    }
-                ++tm.counters.stalls[size_t(Stall::Operand)];
-                ++tm.counters.operand_stalls[size_t(blocking)];
-                // Nothing can change this wait before operands_at but a reply for this TP, which
-                // wakes it; so the cycles in between are operand stalls on `blocking`.
-                if (operands_at == kNever) {
-                    tp.wake_at = kNever;
-                    clear_bit(tm.awake_tps, i);
-                    tp.asleep_from = now + 1;
-                    tp.asleep_on = blocking;
-                } else {
-                    tm.add_operand_stalls(blocking, operands_at - now - 1);
-                    tm.sleep_until(i, operands_at, now);
+            ready |= uint64_t{operands_at <= now} << (i & 63);
+        });
+        for_each_bit(w, holding & ~ready, [&](uint32_t i) {
+            Tm::Tp& tp = tps[i];
+            uint64_t operands_at = 0;
+            for (uint8_t r : tp.pending_regs) operands_at = std::max(operands_at, tp.reg_ready[r]);
+            Pool blocking = Pool::IntAlu;  // producer of the first operand that is ready last
+            for (uint8_t r : tp.pending_regs)
+                if (r != isa::kNumRegs && tp.reg_ready[r] == operands_at) {
+                    blocking = tp.reg_producer[r];
+                    break;
                 }
-                continue;
+            ++counters.stalls[size_t(Stall::Operand)];
+            ++counters.operand_stalls[size_t(blocking)];
+            // Nothing can change this wait before operands_at but a reply for this TP, which
+            // wakes it; so the cycles in between are operand stalls on `blocking`.
+            if (operands_at == kNever) {
+                tp.wake_at = kNever;
+                clear_bit(tm.awake_tps, i);
+                tp.asleep_from = now + 1;
+                tp.asleep_on = blocking;
+            } else {
+                tm.add_operand_stalls(blocking, operands_at - now - 1);
+                tm.sleep_until(i, operands_at);
             }
-            const Pool pool = tp.pending_pool;
-            if (pool == Pool::LoadStore && tp.mem_waiting && !is_local(tp.pending.mem_address)) {
-                ++tm.counters.stalls[size_t(Stall::MemoryPort)];
-                continue;
-            }
+        });
+
+        // One L1 access at a time per TP: a global load/store waits while the previous one
+        // has not reached its L1 bank.
+        const uint64_t port_busy = ready & tm.needs_port_tps[w] & tm.mem_waiting_tps[w];
+        counters.stalls[size_t(Stall::MemoryPort)] += std::popcount(port_busy);
+        for_each_bit(w, ready & ~port_busy, [&](uint32_t i) {
+            const Pool pool = tps[i].pending_pool;
             tm.pools[size_t(pool)].request(i);
             requested_pools |= 1u << size_t(pool);
-        }
-    }
+        });
+    });
 
     // Requests the pools refuse are the FU-busy stalls (the TP keeps its instruction).
     for (; requested_pools != 0; requested_pools &= requested_pools - 1) {
         const auto p = static_cast<size_t>(std::countr_zero(requested_pools));
         const Pool pool = Pool(p);
-        tm.counters.stalls[size_t(Stall::FuBusy)] += tm.pools[p].arbitrate(now, [&](uint32_t i, uint64_t ready) {
-            Tm::Tp& tp = tm.tps[i];
+        counters.stalls[size_t(Stall::FuBusy)] += tm.pools[p].arbitrate(now, [&](uint32_t i, uint64_t ready) {
+            Tm::Tp& tp = tps[i];
             const StepInfo& s = tp.pending;
             const isa::Decoded& d = *s.insn;
             const isa::FuClass fu = tp.pending_class;
-            ++tm.counters.instructions;
-            ++tm.counters.per_class[size_t(fu)];
+            ++counters.instructions;
+            ++counters.per_class[size_t(fu)];
             ++progress_;
             uint64_t result_at = ready;
             if (fu == isa::FuClass::Atomic) {
@@ -360,10 +380,9 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
                 tm.atomics_out.push_back({now, tm.id, tm.atomic_sequence++, i, d.rd});
             } else if (s.mem_bytes != 0 && is_local(s.mem_address)) {
                 tp.lowest_local = std::min(tp.lowest_local, s.mem_address);
-                ++(s.mem_store ? tm.counters.local_stores : tm.counters.local_loads);
+                ++(s.mem_store ? counters.local_stores : counters.local_loads);
                 result_at = ready + config_.tp.local_store_latency;
             } else if (s.mem_bytes != 0) {
-                tp.mem_waiting = true;
                 set_bit(tm.mem_waiting_tps, i);
                 tp.mem_at = ready;
                 tp.mem_request = {s.mem_address, i, d.rd, s.mem_store};
@@ -373,7 +392,8 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
                 tp.reg_ready[d.rd] = result_at;
                 tp.reg_producer[d.rd] = pool;
             }
-            tp.has_pending = false;
+            clear_bit(tm.pending_tps, i);
+            clear_bit(tm.needs_port_tps, i);
             if (s.exited) {
                 clear_bit(tm.awake_tps, i);
                 --tm.running;
@@ -382,9 +402,9 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
                 const uint32_t bubble = s.taken ? config_.tp.branch_taken_penalty
                                                 : config_.tp.branch_not_taken_penalty;
                 if (bubble != 0) {
-                    tm.counters.active_tp_cycles += bubble;
-                    tm.counters.stalls[size_t(Stall::Branch)] += bubble;
-                    tm.sleep_until(i, now + 1 + bubble, now);
+                    counters.active_tp_cycles += bubble;
+                    counters.stalls[size_t(Stall::Branch)] += bubble;
+                    tm.sleep_until(i, now + 1 + bubble);
                 }
             }
         });

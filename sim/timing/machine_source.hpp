@@ -6,6 +6,11 @@
 #include "sim/core/thread_env.hpp"
 #include "timing/chip.hpp"
 
+#include <array>
+#include <exception>
+#include <utility>
+#include <vector>
+
 namespace tpsim::timing {
 
 /// The machine shape a chip needs: one thread per TP, the chip's TM size and local store.
@@ -17,18 +22,58 @@ inline core::MachineConfig machine_config_for(const ChipConfig& chip) {
     return config;
 }
 
+/// Runs each thread ahead of the chip: when the chip fetches an instruction of a thread with
+/// nothing buffered, that instruction executes (exactly when it is fetched, as the model
+/// requires), and so do the following ones while they are private to the thread
+/// (Machine::next_is_private); the chip then takes their records from the buffer. Instructions
+/// that see shared state still execute in fetch order and cycle, so results are the same as
+/// executing each at its fetch, while the functional core runs a thread's code in stretches,
+/// which the host's branch predictors handle far better than one instruction per thread in turn.
 class MachineSource final : public InstructionSource {
 public:
-    explicit MachineSource(core::Machine& machine) : machine_(machine) {}
+    explicit MachineSource(core::Machine& machine)
+        : machine_(machine), ahead_(machine.thread_count()) {}
 
     core::Machine& machine() const { return machine_; }
 
-    uint32_t next_pc(uint32_t thread) const override { return machine_.next_pc(thread); }
+    uint32_t next_pc(uint32_t thread) const override {
+        const Ahead& a = ahead_[thread];
+        return a.next < a.size ? a.records[a.next].pc : machine_.next_pc(thread);
+    }
 
-    void step(uint32_t thread, StepInfo& out) override { machine_.step_inline(thread, out); }
+    void step(uint32_t thread, StepInfo& out) override {
+        Ahead& a = ahead_[thread];
+        if (a.next == a.size) {
+            if (a.fault) std::rethrow_exception(std::exchange(a.fault, nullptr));
+            run_ahead(thread, a);
+        }
+        out = a.records[a.next++];
+    }
 
 private:
+    static constexpr uint32_t kAhead = 32;  // records buffered per thread
+    struct Ahead {
+        std::array<StepInfo, kAhead> records;
+        uint32_t next = 0, size = 0;
+        // A fault of an instruction run ahead, raised when the chip fetches that instruction.
+        std::exception_ptr fault;
+    };
+
+    void run_ahead(uint32_t thread, Ahead& a) {
+        a.next = 0;
+        a.size = 0;
+        machine_.step_inline(thread, a.records[a.size++]);  // a fault here is due now
+        try {
+            while (a.size < kAhead && machine_.next_is_private(thread))
+                machine_.step_inline(thread, a.records[a.size++]);
+        } catch (...) {
+            --a.size;  // the faulting instruction has no record; its pc stays the thread's pc
+            a.fault = std::current_exception();
+        }
+    }
+
     core::Machine& machine_;
+    std::vector<Ahead> ahead_;
 };
 
 }  // namespace tpsim::timing
