@@ -32,14 +32,13 @@ inline core::MachineConfig machine_config_for(const ChipConfig& chip) {
 class MachineSource final : public InstructionSource {
 public:
     explicit MachineSource(core::Machine& machine)
-        : machine_(machine), ahead_(machine.thread_count()) {}
+        : machine_(machine), ahead_(machine.thread_count()), next_pc_(machine.thread_count()) {
+        for (uint32_t t = 0; t < machine.thread_count(); ++t) next_pc_[t] = machine.next_pc(t);
+    }
 
     core::Machine& machine() const { return machine_; }
 
-    uint32_t next_pc(uint32_t thread) const override {
-        const Ahead& a = ahead_[thread];
-        return a.next < a.size ? a.records[a.next].pc : machine_.next_pc(thread);
-    }
+    uint32_t next_pc(uint32_t thread) const override { return next_pc_[thread]; }
 
     void step(uint32_t thread, StepInfo& out) override {
         Ahead& a = ahead_[thread];
@@ -48,6 +47,7 @@ public:
             run_ahead(thread, a);
         }
         out = a.records[a.next++];
+        next_pc_[thread] = a.next < a.size ? a.records[a.next].pc : machine_.next_pc(thread);
     }
 
 private:
@@ -74,6 +74,7 @@ private:
 
     core::Machine& machine_;
     std::vector<Ahead> ahead_;
+    std::vector<uint32_t> next_pc_;  // per thread, dense: the chip asks every fetch cycle
 };
 
 }  // namespace tpsim::timing
