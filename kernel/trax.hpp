@@ -103,6 +103,7 @@ namespace trax::native {
 struct ThreadContext {
     uint32_t* words = nullptr;  ///< global memory, word 0 at kGlobalBase
     int64_t word_count = 0;
+    int64_t read_only_words = 0;  ///< the scene, words [0, read_only_words): stores fault
     uint32_t* global_registers = nullptr;  ///< kGlobalRegisters of them, all 0 at start
     int thread_id = 0, num_threads = 0, tm_id = 0, num_tms = 0, tp_id = 0, tm_size = 0;
 };
@@ -128,6 +129,19 @@ inline uint32_t& word(const char* api, int addr, int offset) {
     return current->words[index];
 }
 
+inline uint32_t& writable_word(const char* api, int addr, int offset) {
+    uint32_t& w = word(api, addr, offset);
+    const int64_t index = int64_t{addr} + offset;
+    if (index < current->read_only_words)
+        throw KernelFault(std::string(api) + "(addr=" + std::to_string(addr) +
+                          ", offset=" + std::to_string(offset) + ") in thread " +
+                          std::to_string(current->thread_id) + ": word " + std::to_string(index) +
+                          " is in the read-only scene data [0, " +
+                          std::to_string(current->read_only_words) +
+                          ") — write results to the framebuffer, thread_stats or ray_results");
+    return w;
+}
+
 }  // namespace trax::native
 
 inline float loadf(int addr, int offset = 0) {
@@ -137,10 +151,10 @@ inline int loadi(int addr, int offset = 0) {
     return static_cast<int>(trax::native::word("loadi", addr, offset));
 }
 inline void storef(float value, int addr, int offset = 0) {
-    trax::native::word("storef", addr, offset) = __builtin_bit_cast(uint32_t, value);
+    trax::native::writable_word("storef", addr, offset) = __builtin_bit_cast(uint32_t, value);
 }
 inline void storei(int value, int addr, int offset = 0) {
-    trax::native::word("storei", addr, offset) = static_cast<uint32_t>(value);
+    trax::native::writable_word("storei", addr, offset) = static_cast<uint32_t>(value);
 }
 inline int atomicinc(int reg) {
     using trax::native::current;

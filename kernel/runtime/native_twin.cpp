@@ -45,6 +45,13 @@ extern "C" __attribute__((visibility("default"))) int tpsim_native_run(const Tra
     trax::native::ThreadContext thread;
     thread.words = ctx->global_words;
     thread.word_count = ctx->global_word_count;
+    // The image starts with the scene header; everything before the framebuffer is the scene,
+    // read-only as on the simulator.
+    if (ctx->global_word_count >= sizeof(trax::layout::SceneHeader) / 4 &&
+        ctx->global_words[trax::layout::kHeaderMagic] == trax::layout::kMagic)
+        thread.read_only_words = std::clamp<int64_t>(
+            int32_t(ctx->global_words[trax::layout::kHeaderFramebuffer]), 0,
+            ctx->global_word_count);
     thread.global_registers = global_registers;
     thread.num_threads = static_cast<int>(ctx->num_threads);
     thread.num_tms = static_cast<int>(ctx->num_tms);

@@ -12,7 +12,7 @@
 namespace tpsim::core {
 
 void MachineConfig::validate() const {
-    MemoryConfig{global_bytes, local_store_bytes, threads}.validate();
+    MemoryConfig{global_bytes, read_only_global_bytes, local_store_bytes, threads}.validate();
     if (threads_per_tm == 0) throw Error("threads per TM must be at least 1");
     if (quantum == 0) throw Error("scheduler quantum must be at least 1 instruction");
     if (max_instructions == 0) throw Error("--max-instructions must be at least 1");
@@ -21,7 +21,8 @@ void MachineConfig::validate() const {
 Machine::Machine(Program program, const MachineConfig& config)
     : program_(std::move(program)), config_(config),
       memory_(program_,
-              MemoryConfig{config.global_bytes, config.local_store_bytes, config.threads}) {
+              MemoryConfig{config.global_bytes, config.read_only_global_bytes,
+                           config.local_store_bytes, config.threads}) {
     config_.validate();
     // Decode the file-backed span of the executable segments once. Words in gaps between them
     // decode as illegal and are reported as fetches outside the code; a zero-filled tail (memsz
@@ -38,8 +39,8 @@ Machine::Machine(Program program, const MachineConfig& config)
     privacy_.reserve(decoded_.size());
     for (const isa::Decoded& d : decoded_) {
         switch (isa::info(d.op).fu) {
-        case isa::FuClass::Load:
-        case isa::FuClass::Store: privacy_.push_back(Privacy::IfLocal); break;
+        case isa::FuClass::Load: privacy_.push_back(Privacy::Load); break;
+        case isa::FuClass::Store: privacy_.push_back(Privacy::Store); break;
         case isa::FuClass::Atomic:
         case isa::FuClass::System: privacy_.push_back(Privacy::Never); break;
         default: privacy_.push_back(Privacy::Always); break;

@@ -21,6 +21,8 @@ struct MachineConfig {
     uint32_t local_store_bytes = 4096;
     /// Bytes of global memory at kGlobalBase (scene image + framebuffer).
     uint32_t global_bytes = 0;
+    /// Leading bytes of global memory that are read-only (MemoryConfig).
+    uint32_t read_only_global_bytes = 0;
     /// Instructions one thread may execute before it faults as a runaway (--max-instructions).
     uint64_t max_instructions = uint64_t(1) << 32;
     /// Instructions a thread runs before the functional scheduler moves to the next thread.
@@ -121,9 +123,9 @@ class Machine {
     uint32_t text_base_ = 0;
     uint32_t text_bytes_ = 0;
     std::vector<isa::Decoded> decoded_; ///< the executable range, one entry per word
-    /// Per word of decoded_: whether the instruction is private (next_is_private), always,
-    /// never, or if its load/store address is in the local store.
-    enum class Privacy : uint8_t { Always, Never, IfLocal };
+    /// Per word of decoded_: whether the instruction is private (next_is_private): always,
+    /// never, or depending on the address it loads from or stores to.
+    enum class Privacy : uint8_t { Always, Never, Load, Store };
     std::vector<Privacy> privacy_;
     std::vector<Thread> threads_;
     std::array<uint32_t, kGlobalRegisters> global_registers_{};

@@ -41,6 +41,10 @@ void MemoryConfig::validate() const {
                                 "bytes from {:#010x}); use a smaller scene or framebuffer",
                                 global_bytes, kMaxGlobal, kGlobalBase));
     if (threads == 0) throw Error("thread count must be at least 1");
+    if (read_only_global_bytes > global_bytes || read_only_global_bytes % 4 != 0)
+        throw Error(fmt::format("read-only global memory of {} bytes must be a multiple of 4 and "
+                                "at most the {} bytes of global memory",
+                                read_only_global_bytes, global_bytes));
 }
 
 Memory::Memory(const Program& program, const MemoryConfig& config) {
@@ -53,6 +57,7 @@ Memory::Memory(const Program& program, const MemoryConfig& config) {
     }
     global_buffer_ = zeroed<Buffer>(config.global_bytes, "global memory");
     global_ = {kGlobalBase, config.global_bytes, global_buffer_.get(), true};
+    read_only_global_ = config.read_only_global_bytes;
     local_stores_ =
         zeroed<Buffer>(size_t(config.threads) * config.local_store_bytes, "local stores");
     local_ = {kLocalTop - config.local_store_bytes, config.local_store_bytes, nullptr, true};
@@ -103,6 +108,12 @@ void Memory::fault(uint32_t addr, uint32_t bytes, bool store) const {
                          fmt::format("{}, running past the end of {}", what,
                                      range(region->base, uint64_t(region->base) + region->size)),
                          "check array bounds and the size of the scene image"};
+    if (region == &global_ && store && in_read_only_global(addr))
+        throw GuestFault{FaultKind::WriteToReadOnly,
+                         fmt::format("{}, inside the read-only scene data {}", what,
+                                     range(global_.base, uint64_t(global_.base) + read_only_global_)),
+                         "the scene (header to BVH) is read-only while a kernel runs; write "
+                         "results to the framebuffer, thread_stats or ray_results sections"};
     if (region && store && !region->writable)
         throw GuestFault{FaultKind::WriteToReadOnly,
                          fmt::format("{}, inside the read-only program segment {}", what,

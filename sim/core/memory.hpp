@@ -13,8 +13,11 @@
 namespace tpsim::core {
 
 struct MemoryConfig {
-    /// Bytes of global memory at kGlobalBase (scene image + framebuffer), read-write.
+    /// Bytes of global memory at kGlobalBase (scene image + framebuffer).
     uint32_t global_bytes = 0;
+    /// The first this many bytes of global memory are read-only (the scene a render loads;
+    /// stores there fault). At most global_bytes, a multiple of 4.
+    uint32_t read_only_global_bytes = 0;
     /// Bytes of each thread's private local store ending at kLocalTop (holds the stack).
     /// A multiple of 16 in [256, 1 MiB].
     uint32_t local_store_bytes = 4096;
@@ -40,6 +43,8 @@ class Memory {
         return {local_stores_.get() + size_t(thread) * local_.size, local_.size};
     }
     uint32_t local_base() const { return local_.base; }
+    /// True if `addr` is in the read-only part of global memory.
+    bool in_read_only_global(uint32_t addr) const { return addr - global_.base < read_only_global_; }
     uint32_t local_store_bytes() const { return local_.size; }
 
     template <class T> T load(uint32_t addr, uint8_t* local) const {
@@ -77,7 +82,8 @@ class Memory {
             // Aligned accesses never straddle the local store: its base and size are multiples
             // of 16.
             if (addr - local_.base < local_.size) return local + (addr - local_.base);
-            if (global_.holds(addr, bytes)) return global_.data + (addr - global_.base);
+            if (global_.holds(addr, bytes) && !(store && in_read_only_global(addr)))
+                return global_.data + (addr - global_.base);
             for (const Region& r : program_regions_)
                 if (r.holds(addr, bytes) && (r.writable || !store)) return r.data + (addr - r.base);
         }
@@ -90,6 +96,7 @@ class Memory {
     std::vector<Region> program_regions_; ///< ELF segments, by address
     Buffer global_buffer_;
     Region global_;
+    uint32_t read_only_global_ = 0; ///< bytes at the start of global_
     Buffer local_stores_; ///< threads x local_.size bytes, zeroed lazily by calloc
     Region local_;        ///< the window; data is per thread
 };

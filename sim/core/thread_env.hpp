@@ -139,15 +139,15 @@ inline bool Machine::next_is_private(uint32_t id) const {
     const Thread& t = threads_[id];
     const uint32_t index = std::rotr(t.hart.pc - text_base_, 2);
     if (t.state != ThreadState::Running || index >= text_bytes_ / 4) return false;
-    switch (privacy_[index]) {
-    case Privacy::Always: return true;
-    case Privacy::Never: return false;
-    case Privacy::IfLocal: break;
-    }
+    const Privacy privacy = privacy_[index];
+    if (privacy == Privacy::Always || privacy == Privacy::Never) return privacy == Privacy::Always;
     // The local store, its overflow guard and the unmapped space above are private: an access
-    // there either touches the thread's own store or faults.
+    // there either touches the thread's own store or faults. Loads from read-only memory see
+    // the same value whenever they run.
     const isa::Decoded& d = decoded_[index];
-    return t.hart.reg[d.rs1] + uint32_t(d.imm) >= trax::map::kLocalTop - trax::map::kStackGuard;
+    const uint32_t addr = t.hart.reg[d.rs1] + uint32_t(d.imm);
+    return addr >= trax::map::kLocalTop - trax::map::kStackGuard ||
+           (privacy == Privacy::Load && memory_.in_read_only_global(addr));
 }
 
 } // namespace tpsim::core

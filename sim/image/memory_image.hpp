@@ -26,6 +26,9 @@ struct MemoryImage {
     std::vector<SectionSize> sections;  ///< in address order, header first
 
     uint64_t bytes() const { return uint64_t(words.size()) * 4; }
+    /// The scene part (header through BVH, before the framebuffer): read-only while a kernel
+    /// runs.
+    uint64_t read_only_bytes() const { return uint64_t(header.framebuffer.addr) * 4; }
 };
 
 /// Lays the scene out. With a BVH, triangles are stored in leaf order and nodes with sibling

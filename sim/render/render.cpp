@@ -25,6 +25,7 @@ InstructionCounts run_functional(const std::filesystem::path& kernel, image::Mem
                                  const timing::ChipConfig& chip, uint64_t max_instructions) {
     core::MachineConfig config = timing::machine_config_for(chip);
     config.global_bytes = uint32_t(image.bytes());
+    config.read_only_global_bytes = uint32_t(image.read_only_bytes());
     config.max_instructions = max_instructions;
     core::Machine machine(core::load_elf(kernel), config);
     std::memcpy(machine.memory().global().data(), image.words.data(), image.bytes());

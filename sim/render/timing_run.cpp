@@ -13,6 +13,7 @@ std::shared_ptr<TimingRun> run_timing(const std::filesystem::path& kernel_elf,
                                       const ProgressCallback& on_progress) {
     core::MachineConfig config = timing::machine_config_for(chip);
     config.global_bytes = uint32_t(image.bytes());
+    config.read_only_global_bytes = uint32_t(image.read_only_bytes());
     config.max_instructions = max_instructions;
 
     auto run = std::make_shared<TimingRun>();

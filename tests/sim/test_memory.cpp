@@ -60,6 +60,23 @@ TEST_CASE("global memory is shared and visible to the host", "[sim][memory]") {
           FaultKind::Unmapped);
 }
 
+TEST_CASE("the read-only start of global memory takes loads and refuses stores", "[sim][memory]") {
+    Memory m(tiny_program(), {.global_bytes = 64, .read_only_global_bytes = 16,
+                              .local_store_bytes = 256, .threads = 1});
+    uint8_t* local = m.local_store(0).data();
+    m.global()[12] = 5;  // the host writes the scene before the run
+    CHECK(m.load<uint8_t>(kGlobalBase + 12, local) == 5);
+    CHECK(m.in_read_only_global(kGlobalBase + 15));
+    CHECK_FALSE(m.in_read_only_global(kGlobalBase + 16));
+    CHECK(fault_of([&] { m.store<uint32_t>(kGlobalBase + 12, 1, local); }) ==
+          FaultKind::WriteToReadOnly);
+    CHECK(fault_of([&] { m.store<uint8_t>(kGlobalBase, 1, local); }) == FaultKind::WriteToReadOnly);
+    m.store<uint32_t>(kGlobalBase + 16, 7, local);
+    CHECK(m.load<uint32_t>(kGlobalBase + 16, local) == 7);
+    CHECK_THROWS_AS(Memory(tiny_program(), {.global_bytes = 64, .read_only_global_bytes = 68}),
+                    tpsim::Error);
+}
+
 TEST_CASE("local stores are private per thread and overflow is detected", "[sim][memory]") {
     Memory m(tiny_program(), {.global_bytes = 0, .local_store_bytes = 256, .threads = 3});
     CHECK(m.local_base() == kLocalTop - 256);

@@ -3,7 +3,12 @@
 #include "sim/render/render.hpp"
 #include "sim/render/report.hpp"
 #include "sim/render/timing_run.hpp"
+#include "sim/core/elf_loader.hpp"
+#include "sim/image/memory_image.hpp"
+#include "sim/scene/bvh.hpp"
+#include "sim/scene/load_scene.hpp"
 #include "timing/config.hpp"
+#include "timing/machine_source.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -111,5 +116,68 @@ TEST_CASE("every key a cycle-level render registers is documented in docs/statis
         INFO(e.name);
         CHECK(std::any_of(documented.begin(), documented.end(),
                           [&](const std::regex& re) { return std::regex_match(e.name, re); }));
+    }
+}
+
+namespace {
+
+/// The reference the machine source's run-ahead must match: every instruction executed at
+/// the moment the chip fetches it.
+class StepAtFetch : public timing::InstructionSource {
+public:
+    explicit StepAtFetch(core::Machine& machine) : machine_(machine) {}
+    uint32_t next_pc(uint32_t thread) const override { return machine_.next_pc(thread); }
+    void step(uint32_t thread, timing::StepInfo& out) override { out = machine_.step(thread); }
+
+private:
+    core::Machine& machine_;
+};
+
+struct ChipRun {
+    std::string stats;                 // every chip statistic, name=value lines
+    std::vector<uint32_t> global;      // global memory afterwards (framebuffer included)
+};
+
+template <class Source>
+ChipRun run_chip(const timing::ChipConfig& chip) {
+    const scene::Scene scene = scene::load_scene(small_cornell());
+    scene::BvhConfig bvh_config;
+    bvh_config.traversal_stack_entries = trax::layout::kTraversalStackEntries;
+    const scene::Bvh bvh = scene::build_bvh(scene.triangles, bvh_config);
+    const image::MemoryImage image =
+        image::build_memory_image(scene, &bvh, chip.chip.num_tms * chip.chip.tps_per_tm);
+    core::MachineConfig config = timing::machine_config_for(chip);
+    config.global_bytes = uint32_t(image.bytes());
+    config.read_only_global_bytes = uint32_t(image.read_only_bytes());
+    core::Machine machine(core::load_elf(TPSIM_KERNEL_DIR "/tracer.elf"), config);
+    std::memcpy(machine.memory().global().data(), image.words.data(), image.bytes());
+    Source source(machine);
+    timing::Chip model(chip, source);
+    model.run();
+    stats::Registry registry;
+    model.register_stats(registry);
+    ChipRun run;
+    for (const stats::Entry& e : registry.entries())
+        run.stats += e.name + '=' + std::to_string(e.value()) + '\n';
+    const auto global = machine.memory().global();
+    run.global.resize(global.size() / 4);
+    std::memcpy(run.global.data(), global.data(), global.size());
+    return run;
+}
+
+}  // namespace
+
+TEST_CASE("running threads ahead through private instructions changes nothing the chip reports",
+          "[render][determinism]") {
+    for (const char* shape : {"chip.tps_per_tm=8", "chip.tps_per_tm=70"}) {
+        timing::ChipConfig chip = tiny();
+        timing::apply_override(chip, shape);
+        timing::apply_override(chip, "icache.threads_per_icache=2");
+        INFO(shape);
+        const ChipRun ahead = run_chip<timing::MachineSource>(chip);
+        const ChipRun at_fetch = run_chip<StepAtFetch>(chip);
+        CHECK(ahead.stats == at_fetch.stats);
+        CHECK(ahead.global == at_fetch.global);
+        CHECK(ahead.stats.find("chip/instructions=0\n") == std::string::npos);
     }
 }
