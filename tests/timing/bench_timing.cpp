@@ -32,6 +32,7 @@ int main(int argc, char** argv) try {
 
     core::MachineConfig config = timing::machine_config_for(chip);
     config.global_bytes = uint32_t(image.bytes());
+    config.read_only_global_bytes = uint32_t(image.read_only_bytes());
     core::Machine machine(core::load_elf(argv[2]), config);
     std::memcpy(machine.memory().global().data(), image.words.data(), image.bytes());
     timing::MachineSource source(machine);
