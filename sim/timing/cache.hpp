@@ -112,10 +112,11 @@ public:
         const uint32_t word = pc / 4;
         const uint32_t in_icache = bank_mask_ ? word & bank_mask_ : word % banks_per_icache_;
         Bank& bank = banks_[first_bank_[tp] + in_icache];
-        // Written without branches: whether a fetch conflicts is unpredictable for the host.
-        const bool granted = bank.cycle != now || bank.pc == pc;
+        // Written without branches (bitwise | and a mask, which compilers keep branch-free):
+        // whether a fetch conflicts is unpredictable for the host.
+        const bool granted = (bank.cycle != now) | (bank.pc == pc);
         bank.cycle = now;
-        bank.pc = granted ? pc : bank.pc;
+        bank.pc ^= (bank.pc ^ pc) & -uint32_t{granted};
         counters_.conflicts += !granted;
         counters_.fetches += granted;
         return granted;
