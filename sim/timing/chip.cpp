@@ -310,8 +310,8 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             // rd too: no write-after-write reorder. kNoReg maps to the always-ready last slot.
             tp.pending_regs = {std::min(d.rs1, isa::kNumRegs), std::min(d.rs2, isa::kNumRegs),
                                std::min(d.rs3, isa::kNumRegs), std::min(d.rd, isa::kNumRegs)};
-            const bool needs_port =
-                tp.pending_pool == Pool::LoadStore && !is_local(tp.pending.mem_address);
+            const bool needs_port =  // bitwise &: no branch on an unpredictable outcome
+                (tp.pending_pool == Pool::LoadStore) & !is_local(tp.pending.mem_address);
             tm.needs_port_tps[w] |= uint64_t{needs_port} << (i & 63);
         });
         tm.pending_tps[w] |= fetched;
