@@ -229,7 +229,8 @@ void Machine::refuse_step(uint32_t id) {
 
 StepRecord Machine::step(uint32_t id) {
     StepRecord record;
-    step_inline(id, record);
+    uint32_t done = 0;
+    run_ahead(id, &record, 1, done);
     return record;
 }
 

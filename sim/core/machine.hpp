@@ -76,9 +76,12 @@ class Machine {
 
     /// Executes one instruction of a running thread and reports what it did. Throws Fault.
     StepRecord step(uint32_t thread);
-    /// step() into `record`, defined in thread_env.hpp so the timing model's cycle loop can
-    /// inline it and the record lands where the caller keeps it (no copy).
-    inline void step_inline(uint32_t thread, StepRecord& record);
+    /// The timing model's batched step(): executes thread `id`'s next instruction, then the
+    /// following ones while next_is_private(id), at most `capacity` in all (and never past the
+    /// instruction limit), writing their records to out[0..done). If an instruction faults,
+    /// the Fault is thrown with `done` counting the records written before it. Defined in
+    /// thread_env.hpp so the cycle loop can inline it.
+    inline void run_ahead(uint32_t id, StepRecord* out, uint32_t capacity, uint32_t& done);
 
     /// True if thread `id` is running and its next instruction touches only the thread's own
     /// state (registers, pc, local store): executing it earlier or later than other threads'

@@ -1,4 +1,4 @@
-// The per-instruction execution environment (ThreadEnv) and Machine::step_inline, in a header
+// The per-instruction execution environment (ThreadEnv) and Machine::run_ahead, in a header
 // so the timing model's cycle loop can inline the whole step (fetch check, execute, record)
 // instead of calling through machine.cpp for every simulated instruction.
 #pragma once
@@ -76,6 +76,9 @@ template <bool kRecord> class ThreadEnv {
 
     void illegal(isa::Hart& h, const isa::Decoded& d) { machine_.illegal(id_, h, d); }
 
+    /// Where the next instruction's bookkeeping goes (recording environments only).
+    void record_into(StepRecord* record) { record_ = record; }
+
   private:
     [[noreturn, gnu::cold, gnu::noinline]] static void bad_global_register(uint32_t index) {
         throw GuestFault{FaultKind::BadGlobalRegister,
@@ -105,34 +108,44 @@ template <bool kRecord> class ThreadEnv {
     [[no_unique_address]] Record record_;
 };
 
-// The timing model's hot path (once per simulated instruction): every check in one unlikely
-// branch, the environment built inline, the fault paths out of line. Flattened: GCC would
-// otherwise keep isa::execute out of line (too big for its inliner), which costs a call and
-// keeps the environment and record in memory instead of registers.
-[[gnu::flatten]] inline void Machine::step_inline(uint32_t id, StepRecord& record) {
+// The timing model's hot path: the functional core's stretch of one thread (see
+// MachineSource). Every check in one unlikely branch, the fault paths out of line. Flattened:
+// GCC would otherwise keep isa::execute out of line (too big for its inliner), which costs a
+// call and keeps the environment and record in memory instead of registers.
+[[gnu::flatten]] inline void Machine::run_ahead(uint32_t id, StepRecord* out, uint32_t capacity,
+                                                uint32_t& done) {
+    done = 0;
     // config_.threads, not threads_.size(): no division by sizeof(Thread).
     if (id >= config_.threads) [[unlikely]]
         refuse_step(id);
     Thread& t = threads_[id];
     if (t.state != ThreadState::Running || t.executed == config_.max_instructions) [[unlikely]]
         refuse_step(id);
+    // Stop at the instruction limit: the next call then reports the runaway at its fetch.
+    capacity = uint32_t(std::min<uint64_t>(capacity, config_.max_instructions - t.executed));
     isa::Hart& h = t.hart;
-    const uint32_t pc = h.pc;
-    const uint32_t index = std::rotr(pc - text_base_, 2); // range and alignment, as in run_quantum
-    if (index >= text_bytes_ / 4) [[unlikely]]
-        fetch_fault(id, pc);
-    const isa::Decoded& d = decoded_[index];
-    ++counters_.per_op[size_t(d.op)];
-    record = StepRecord{.pc = pc, .insn = &d};
-    ThreadEnv<true> env(*this, id, &record);
+    ThreadEnv<true> env(*this, id, out);
+    uint32_t pc = h.pc;
     try {
-        isa::execute(d, h, env);
+        do {
+            pc = h.pc;
+            const uint32_t index = std::rotr(pc - text_base_, 2); // range and alignment, as in run_quantum
+            if (index >= text_bytes_ / 4) [[unlikely]]
+                fetch_fault(id, pc);
+            const isa::Decoded& d = decoded_[index];
+            ++counters_.per_op[size_t(d.op)];
+            StepRecord& record = out[done];
+            record = StepRecord{.pc = pc, .insn = &d};
+            env.record_into(&record);
+            isa::execute(d, h, env);
+            record.taken = !record.exited && h.pc != pc + 4;
+            ++done;
+            ++t.executed;
+            ++counters_.instructions;
+        } while (done < capacity && next_is_private(id));
     } catch (const GuestFault& f) {
         fault(id, pc, f);
     }
-    ++t.executed;
-    ++counters_.instructions;
-    record.taken = !record.exited && h.pc != pc + 4;
 }
 
 inline bool Machine::next_is_private(uint32_t id) const {

@@ -61,13 +61,11 @@ private:
 
     void run_ahead(uint32_t thread, Ahead& a) {
         a.next = 0;
-        a.size = 0;
-        machine_.step_inline(thread, a.records[a.size++]);  // a fault here is due now
         try {
-            while (a.size < kAhead && machine_.next_is_private(thread))
-                machine_.step_inline(thread, a.records[a.size++]);
+            machine_.run_ahead(thread, a.records.data(), kAhead, a.size);
         } catch (...) {
-            --a.size;  // the faulting instruction has no record; its pc stays the thread's pc
+            if (a.size == 0) throw;  // the fetched instruction itself: its fault is due now
+            // A later one's: raised when the chip fetches it (its pc stays the thread's pc).
             a.fault = std::current_exception();
         }
     }
