@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <bit>
 
 #include <stdexcept>
@@ -11,6 +12,9 @@ namespace tpsim::timing {
 Cache::Cache(const CacheConfig& config)
     : config_(config),
       num_sets_(config.size_bytes / (config.ways * config.line_bytes)),
+      line_shift_(static_cast<uint32_t>(std::countr_zero(config.line_bytes))),
+      bank_mod_(config.banks),
+      set_mod_(std::max(num_sets_, 1u)),
       ways_(size_t{num_sets_} * config.ways),
       mshrs_(config.mshrs),
       bank_used_at_(config.banks, UINT64_MAX) {
@@ -137,8 +141,7 @@ void Cache::register_stats(stats::Registry& r, std::string_view prefix) const {
 }
 
 ICacheBanks::ICacheBanks(const ICacheConfig& config, uint32_t num_threads)
-    : banks_per_icache_(config.banks),
-      bank_mask_(config.banks > 1 && std::has_single_bit(config.banks) ? config.banks - 1 : 0),
+    : bank_mod_(config.banks),
       banks_(size_t{(num_threads + config.threads_per_icache - 1) / config.threads_per_icache} *
              config.banks) {
     for (uint32_t tp = 0; tp < num_threads; ++tp)

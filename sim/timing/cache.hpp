@@ -10,12 +10,27 @@
 #include "timing/config.hpp"
 #include "timing/memory.hpp"
 
+#include <bit>
 #include <cstdint>
 #include <deque>
 #include <string_view>
 #include <vector>
 
 namespace tpsim::timing {
+
+/// n % divisor without a division when the divisor is a power of two (the usual bank and set
+/// counts): the caches take several per access, the I-cache one per fetch.
+class Modulus {
+public:
+    explicit Modulus(uint32_t divisor)
+        : divisor_(divisor), power_of_two_(std::has_single_bit(divisor)), mask_(divisor - 1) {}
+    uint32_t of(uint32_t n) const { return power_of_two_ ? n & mask_ : n % divisor_; }
+
+private:
+    uint32_t divisor_;
+    bool power_of_two_;
+    uint32_t mask_;
+};
 
 enum class CacheOutcome : uint8_t {
     Hit,           ///< reply queued for now + hit_latency
@@ -58,7 +73,7 @@ public:
     const std::deque<OutboundRequest>& outbound() const { return outbound_; }
     bool contains(uint32_t addr) const;
     uint32_t line_of(uint32_t addr) const { return addr & ~(config_.line_bytes - 1); }
-    uint32_t bank_of(uint32_t addr) const { return (addr / config_.line_bytes) % config_.banks; }
+    uint32_t bank_of(uint32_t addr) const { return bank_mod_.of(addr >> line_shift_); }
     uint32_t outstanding_misses() const;
 
     const Counters& counters() const { return counters_; }
@@ -79,10 +94,13 @@ private:
 
     Way* find(uint32_t line);
     const Way* find(uint32_t line) const;
-    uint32_t set_of(uint32_t line) const { return (line / config_.line_bytes) % num_sets_; }
+    uint32_t set_of(uint32_t line) const { return set_mod_.of(line >> line_shift_); }
 
     CacheConfig config_;
     uint32_t num_sets_;
+    uint32_t line_shift_;  // log2(line_bytes), validated a power of two
+    Modulus bank_mod_;
+    Modulus set_mod_;
     std::vector<Way> ways_;               // num_sets_ x ways
     std::vector<Mshr> mshrs_;
     std::vector<uint64_t> bank_used_at_;  // last cycle each bank accepted an access
@@ -109,9 +127,7 @@ public:
     bool fetch(uint64_t now, uint32_t tp, uint32_t pc) {
         // No division per fetch (once per simulated instruction): the thread's first bank is
         // precomputed, and a power-of-two bank count is a mask.
-        const uint32_t word = pc / 4;
-        const uint32_t in_icache = bank_mask_ ? word & bank_mask_ : word % banks_per_icache_;
-        Bank& bank = banks_[first_bank_[tp] + in_icache];
+        Bank& bank = banks_[first_bank_[tp] + bank_mod_.of(pc / 4)];
         // Written without branches (bitwise | and a mask, which compilers keep branch-free):
         // whether a fetch conflicts is unpredictable for the host.
         const bool granted = (bank.cycle != now) | (bank.pc == pc);
@@ -130,8 +146,7 @@ private:
         uint64_t cycle = UINT64_MAX;  // cycle of the current reservation
         uint32_t pc = 0;
     };
-    uint32_t banks_per_icache_;
-    uint32_t bank_mask_;                // banks - 1 if a power of two above 1, else 0
+    Modulus bank_mod_;                  // banks per I-cache
     std::vector<uint32_t> first_bank_;  // per thread: index of its I-cache's bank 0
     std::vector<Bank> banks_;  // all I-caches of the TM, banks_per_icache_ each
     Counters counters_;
