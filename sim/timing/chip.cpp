@@ -26,6 +26,16 @@ void clear_bit(std::vector<uint64_t>& bits, uint32_t i) {
     bits[i >> 6] &= ~(uint64_t{1} << (i & 63));
 }
 
+/// std::popcount, inline: built for the x86-64 baseline (no POPCNT instruction), GCC calls
+/// libgcc for it, several times per TM and cycle.
+constexpr uint32_t count_bits(uint64_t x) {
+    x -= (x >> 1) & 0x5555'5555'5555'5555;
+    x = (x & 0x3333'3333'3333'3333) + ((x >> 2) & 0x3333'3333'3333'3333);
+    x = (x + (x >> 4)) & 0x0f0f'0f0f'0f0f'0f0f;
+    return static_cast<uint32_t>((x * 0x0101'0101'0101'0101) >> 56);
+}
+static_assert(count_bits(0) == 0 && count_bits(~uint64_t{0}) == 64 && count_bits(0x8001) == 2);
+
 /// Calls f(word_index, mask) so that the masks' bits, taken in order, visit every bit index in
 /// rotating order: start, start + 1, ..., wrapping to 0. The first word comes twice: its bits
 /// from `start` up first, the ones below last.
@@ -293,14 +303,14 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
     auto& counters = tm.counters;
     for_each_rotated_part(tm.words, tm.rotation, [&](uint32_t w, uint64_t part) {
         const uint64_t visiting = tm.awake_tps[w] & part;
-        counters.active_tp_cycles += std::popcount(visiting);
+        counters.active_tp_cycles += count_bits(visiting);
 
         const uint64_t fetching = visiting & ~tm.pending_tps[w];
         uint64_t fetched = 0;
         for_each_bit(w, fetching, [&](uint32_t i) {
             fetched |= uint64_t{tm.icache.fetch(now, i, source.next_pc(first_thread + i))} << (i & 63);
         });
-        counters.stalls[size_t(Stall::FetchConflict)] += std::popcount(fetching & ~fetched);
+        counters.stalls[size_t(Stall::FetchConflict)] += count_bits(fetching & ~fetched);
         for_each_bit(w, fetched, [&](uint32_t i) {
             Tm::Tp& tp = tps[i];
             source.step(first_thread + i, tp.pending);
@@ -354,7 +364,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
         // One L1 access at a time per TP: a global load/store waits while the previous one
         // has not reached its L1 bank.
         const uint64_t port_busy = ready & tm.needs_port_tps[w] & tm.mem_waiting_tps[w];
-        counters.stalls[size_t(Stall::MemoryPort)] += std::popcount(port_busy);
+        counters.stalls[size_t(Stall::MemoryPort)] += count_bits(port_busy);
         for_each_bit(w, ready & ~port_busy, [&](uint32_t i) {
             const Pool pool = tps[i].pending_pool;
             tm.pools[size_t(pool)].request(i);

@@ -57,6 +57,7 @@ public:
             if (k == 0) bits &= ~below_start;
             else if (k == words) bits &= below_start;
             else if (w == first_word) continue;
+            if (k != 0) requested_[w] = 0;  // its last visit (cleared here: no memset call)
             for (; bits != 0; bits &= bits - 1) {
                 if (!try_start(now)) break;  // no unit frees up within a cycle: the rest lose too
                 const uint32_t id = (w << 6) + static_cast<uint32_t>(std::countr_zero(bits));
@@ -69,7 +70,6 @@ public:
         counters_.denied += denied;
         if (last_granted != kNone)
             next_priority_ = last_granted + 1 == num_requesters_ ? 0 : last_granted + 1;
-        std::fill(requested_.begin(), requested_.end(), 0);
         requests_ = 0;
         return denied;
     }
