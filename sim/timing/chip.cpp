@@ -292,20 +292,16 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
         });
     });
 
-    // Every awake TP, in rotating order: fetch if it holds no instruction, check the
-    // scoreboard, request a unit. Done in passes over bit sets, each pass a short loop with
-    // few data-dependent branches; only fetch (I-cache banks, and the functional step, whose
-    // shared-memory effects must happen in fetch order) depends on the order.
+    // Every awake TP: fetch if it holds no instruction, check the scoreboard, request a unit.
+    // Done in passes over bit sets, each pass a short loop with few data-dependent branches.
+    // Only fetch depends on the order (I-cache banks, and the functional step, whose
+    // shared-memory effects must happen in fetch order): it goes in rotating order.
     tm.wake_timed(now);
     Tm::Tp* const tps = tm.tps.data();
     const uint32_t first_thread = tm.id * n;
-    uint32_t requested_pools = 0;  // bit per pool with a request this cycle
     auto& counters = tm.counters;
     for_each_rotated_part(tm.words, tm.rotation, [&](uint32_t w, uint64_t part) {
-        const uint64_t visiting = tm.awake_tps[w] & part;
-        counters.active_tp_cycles += count_bits(visiting);
-
-        const uint64_t fetching = visiting & ~tm.pending_tps[w];
+        const uint64_t fetching = tm.awake_tps[w] & part & ~tm.pending_tps[w];
         uint64_t fetched = 0;
         for_each_bit(w, fetching, [&](uint32_t i) {
             fetched |= uint64_t{tm.icache.fetch(now, i, source.next_pc(first_thread + i))} << (i & 63);
@@ -325,6 +321,12 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             tm.needs_port_tps[w] |= uint64_t{needs_port} << (i & 63);
         });
         tm.pending_tps[w] |= fetched;
+    });
+
+    uint32_t requested_pools = 0;  // bit per pool with a request this cycle
+    for (uint32_t w = 0; w < tm.words; ++w) {
+        const uint64_t visiting = tm.awake_tps[w];
+        counters.active_tp_cycles += count_bits(visiting);
 
         // Scoreboard: ready when every operand (and rd: no write-after-write reorder) is.
         const uint64_t holding = visiting & tm.pending_tps[w];
@@ -370,7 +372,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             tm.pools[size_t(pool)].request(i);
             requested_pools |= 1u << size_t(pool);
         });
-    });
+    }
 
     // Requests the pools refuse are the FU-busy stalls (the TP keeps its instruction).
     for (; requested_pools != 0; requested_pools &= requested_pools - 1) {
