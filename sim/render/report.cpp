@@ -94,9 +94,14 @@ void print_summary(const RenderOptions& options, const RenderResult& r, std::ost
                : options.engine == Engine::timing ? "the cycle-level chip model"
                                                   : "the functional simulator",
                options.chip.chip.num_tms, options.chip.chip.tps_per_tm, r.threads);
-    fmt::print(out, "memory   {:.1f} KiB:", double(r.image.bytes()) / 1024);
+    fmt::print(out, "memory   {:.1f} KiB ({:.1f} KiB read-only scene):", double(r.image.bytes()) / 1024,
+               double(r.image.read_only_bytes()) / 1024);
+    const char* separator = " ";
     for (const image::SectionSize& s : r.image.sections)
-        if (s.records > 0) fmt::print(out, " {} {:.1f} KiB,", s.name, double(s.bytes) / 1024);
+        if (s.records > 0) {
+            fmt::print(out, "{}{} {:.1f} KiB", separator, s.name, double(s.bytes) / 1024);
+            separator = ", ";
+        }
     fmt::print(out, "\n");
     if (r.bvh)
         fmt::print(out, "bvh      {} nodes, {} leaves, depth {}, SAH cost {:.2f}, built in {:.3f} s{}\n",
