@@ -12,6 +12,7 @@
 
 #include <cxxabi.h>
 #include <elf.h>
+#include <dwarf.h>
 #include <elfutils/libdw.h>
 #include <fmt/format.h>
 #include <gelf.h>
@@ -212,6 +213,38 @@ std::vector<Symbol> read_functions(Elf* elf, const std::vector<Segment>& segment
     return functions;
 }
 
+/// File name without directories.
+std::string base_name(const char* path) {
+    std::string file = path ? path : "?";
+    if (auto slash = file.rfind('/'); slash != std::string::npos) file = file.substr(slash + 1);
+    return file;
+}
+
+/// Collects the inlined calls below `die` (depth = nesting level) with their call sites.
+/// Nesting beyond kMaxDepth (only a damaged file has it) is ignored, bounding the recursion.
+void read_inlined_calls(Dwarf_Die* die, Dwarf_Files* files, uint32_t depth, Program& program) {
+    constexpr uint32_t kMaxDepth = 64;
+    Dwarf_Die child;
+    if (depth > kMaxDepth || dwarf_child(die, &child) != 0) return;
+    do {
+        if (dwarf_tag(&child) == DW_TAG_inlined_subroutine) {
+            Dwarf_Attribute attribute;
+            Dwarf_Word file = 0, line = 0;
+            const bool has_site =
+                dwarf_formudata(dwarf_attr(&child, DW_AT_call_file, &attribute), &file) == 0 &&
+                dwarf_formudata(dwarf_attr(&child, DW_AT_call_line, &attribute), &line) == 0;
+            if (has_site && files) {
+                const SourceLocation site{base_name(dwarf_filesrc(files, file, nullptr, nullptr)),
+                                          uint32_t(line)};
+                Dwarf_Addr base = 0, low = 0, high = 0;
+                for (ptrdiff_t at = 0; (at = dwarf_ranges(&child, at, &base, &low, &high)) > 0;)
+                    program.inlined_calls.push_back({uint32_t(low), uint32_t(high), depth, site});
+            }
+        }
+        read_inlined_calls(&child, files, depth + 1, program);
+    } while (dwarf_siblingof(&child, &child) == 0);
+}
+
 /// Fills the line table from .debug_line when present; missing or unreadable DWARF just means
 /// messages carry no file:line.
 void read_lines(Elf* elf, Program& program) {
@@ -234,15 +267,17 @@ void read_lines(Elf* elf, Program& program) {
                 if (!line || dwarf_lineaddr(line, &addr) != 0 || dwarf_lineno(line, &lineno) != 0 ||
                     dwarf_lineendsequence(line, &end) != 0)
                     continue;
-                const char* src = dwarf_linesrc(line, nullptr, nullptr);
-                std::string file = src ? src : "?";
-                if (auto slash = file.rfind('/'); slash != std::string::npos)
-                    file = file.substr(slash + 1);
+                const std::string file = base_name(dwarf_linesrc(line, nullptr, nullptr));
                 auto [it, inserted] = file_index.try_emplace(file, program.line_files.size());
                 if (inserted) program.line_files.push_back(file);
                 program.line_rows.push_back({uint32_t(addr), uint32_t(lineno), it->second, end});
             }
         }
+        Dwarf_Files* files = nullptr;
+        size_t file_count = 0;
+        if (dwarf_offdie(dwarf, offset + header_size, &cu) &&
+            dwarf_getsrcfiles(&cu, &files, &file_count) == 0)
+            read_inlined_calls(&cu, files, 0, program);
         offset = next;
     }
     dwarf_end(dwarf);
@@ -285,6 +320,17 @@ std::optional<SourceLocation> Program::source_at(uint32_t pc) const {
         --row;
     if (row->end_sequence || row->line == 0) return std::nullopt;
     return SourceLocation{line_files[row->file], row->line};
+}
+
+std::vector<SourceLocation> Program::inlined_call_sites(uint32_t pc) const {
+    std::vector<const InlinedCall*> around;
+    for (const InlinedCall& call : inlined_calls)
+        if (pc >= call.low && pc < call.high) around.push_back(&call);
+    std::sort(around.begin(), around.end(),
+              [](const InlinedCall* a, const InlinedCall* b) { return a->depth > b->depth; });
+    std::vector<SourceLocation> sites;
+    for (const InlinedCall* call : around) sites.push_back(call->call_site);
+    return sites;
 }
 
 const Segment* Program::segment_at(uint32_t addr) const {

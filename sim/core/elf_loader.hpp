@@ -45,6 +45,10 @@ class Program {
     std::string describe_pc(uint32_t pc) const;
     /// The source line of pc from DWARF .debug_line, when the ELF was built with -g.
     std::optional<SourceLocation> source_at(uint32_t pc) const;
+    /// Where the inlined functions around pc were called from, innermost first (e.g. the
+    /// kernel line that called storef() when pc is in storef's inlined body); empty if pc is in
+    /// no inlined code or the ELF has no DWARF.
+    std::vector<SourceLocation> inlined_call_sites(uint32_t pc) const;
     /// The segment holding addr, or nullptr.
     const Segment* segment_at(uint32_t addr) const;
 
@@ -57,6 +61,13 @@ class Program {
     };
     std::vector<LineRow> line_rows;
     std::vector<std::string> line_files;
+    /// Loader-internal: one address range of an inlined call (DW_TAG_inlined_subroutine).
+    struct InlinedCall {
+        uint32_t low, high;  ///< [low, high)
+        uint32_t depth;      ///< nesting depth in the DIE tree: larger = more inner
+        SourceLocation call_site;
+    };
+    std::vector<InlinedCall> inlined_calls;
 };
 
 /// Reads and validates an ELF file. Throws tpsim::Error (one line naming the file, the problem

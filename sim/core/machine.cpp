@@ -57,8 +57,12 @@ Machine::Machine(Program program, const MachineConfig& config)
 void Machine::fault(uint32_t id, uint32_t pc, const GuestFault& what) {
     threads_[id].state = ThreadState::Faulted;
     std::string where = program_.describe_pc(pc);
-    if (auto source = program_.source_at(pc))
+    if (auto source = program_.source_at(pc)) {
         where += fmt::format("{}{}:{}", where.empty() ? "" : ", ", source->file, source->line);
+        // In an inlined function (e.g. the kernel API's storef), name the lines that called it.
+        for (const SourceLocation& site : program_.inlined_call_sites(pc))
+            where += fmt::format(", called from {}:{}", site.file, site.line);
+    }
     // Name the instruction that did it, unless there is none: no code there, an undecodable
     // word (the detail shows it), or a limit that stopped the thread before this instruction.
     const Segment* segment = program_.segment_at(pc);
