@@ -102,7 +102,9 @@ struct Chip::Tm {
         : id(id), words((c.chip.tps_per_tm + 63) / 64), tps(c.chip.tps_per_tm),
           icache(c.icache, c.chip.tps_per_tm), l1(c.l1), awake_tps(words), pending_tps(words),
           needs_port_tps(words), mem_waiting_tps(words),
-          wheel_slots(std::bit_ceil(longest_timed_sleep(c) + 1)), wheel(wheel_slots * words) {
+          wheel_slots(std::min(std::bit_ceil(longest_timed_sleep(c) + 1), kMaxWheelSlots)),
+          sleeps_outlast_wheel(longest_timed_sleep(c) >= wheel_slots),
+          wheel(wheel_slots * words) {
         for (uint32_t i = 0; i < c.chip.tps_per_tm; ++i) set_bit(awake_tps, i);
         for (size_t p = 0; p < kPools; ++p)
             pools.emplace_back(pool_config(c.fu, Pool(p)), c.chip.tps_per_tm);
@@ -121,17 +123,30 @@ struct Chip::Tm {
         add_operand_stalls(tp.asleep_on, now - tp.asleep_from);
         tp.wake_at = now;
     }
-    /// TP i leaves the awake set until cycle `at` (now < at <= now + longest_timed_sleep),
-    /// when the wheel puts it back.
-    void sleep_until(uint32_t i, uint64_t at) {
+    /// TP i leaves the awake set until cycle `at` (> now), when the wheel puts it back. A
+    /// sleep longer than the wheel (configs with huge latencies) waits in the wheel's last slot
+    /// and is put back to sleep by wake_timed.
+    void sleep_until(uint32_t i, uint64_t at, uint64_t now) {
         tps[i].wake_at = at;
         clear_bit(awake_tps, i);
-        set_bit(wheel, uint32_t(at & (wheel_slots - 1)) * 64 * words + i);
+        const uint64_t slot = (at - now < wheel_slots ? at : now + wheel_slots - 1) & (wheel_slots - 1);
+        set_bit(wheel, uint32_t(slot) * 64 * words + i);
     }
     /// Start of cycle `now`: the TPs whose timed sleep ends join the awake set.
     void wake_timed(uint64_t now) {
         uint64_t* slot = &wheel[(now & (wheel_slots - 1)) * words];
-        for (uint32_t w = 0; w < words; ++w) awake_tps[w] |= std::exchange(slot[w], 0);
+        for (uint32_t w = 0; w < words; ++w) {
+            uint64_t due = std::exchange(slot[w], 0);
+            if (sleeps_outlast_wheel)
+                for (uint64_t bits = due; bits != 0; bits &= bits - 1) {
+                    const uint32_t i = (w << 6) + static_cast<uint32_t>(std::countr_zero(bits));
+                    if (tps[i].wake_at > now) {
+                        due &= ~(uint64_t{1} << (i & 63));
+                        sleep_until(i, tps[i].wake_at, now);
+                    }
+                }
+            awake_tps[w] |= due;
+        }
     }
 
     uint32_t id;
@@ -150,9 +165,11 @@ struct Chip::Tm {
     TpBits pending_tps;      // holding a fetched instruction
     TpBits needs_port_tps;   // ... that is a load/store to global memory (needs the L1 port)
     TpBits mem_waiting_tps;  // a granted load/store waits for its L1 access
-    // Timed sleeps: wheel_slots TpBits (a power of two above the longest sleep), the one for
-    // cycle t at t % wheel_slots.
+    // Timed sleeps: wheel_slots TpBits (a power of two above the longest sleep, at most
+    // kMaxWheelSlots), the one for cycle t at t % wheel_slots.
+    static constexpr uint64_t kMaxWheelSlots = 1024;
     uint64_t wheel_slots;
+    bool sleeps_outlast_wheel;
     TpBits wheel;
     Counters counters;
 };
@@ -359,7 +376,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
                 tp.asleep_on = blocking;
             } else {
                 tm.add_operand_stalls(blocking, operands_at - now - 1);
-                tm.sleep_until(i, operands_at);
+                tm.sleep_until(i, operands_at, now);
             }
         });
 
@@ -416,7 +433,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
                 if (bubble != 0) {
                     counters.active_tp_cycles += bubble;
                     counters.stalls[size_t(Stall::Branch)] += bubble;
-                    tm.sleep_until(i, now + 1 + bubble);
+                    tm.sleep_until(i, now + 1 + bubble, now);
                 }
             }
         });

@@ -94,6 +94,29 @@ TEST_CASE("a dependent chain waits for the producing unit's latency", "[chip]") 
     CHECK(stat(r, "tm0/class/fp_mul") == uint64_t(n));
 }
 
+TEST_CASE("latencies and penalties longer than the sleep wheel are exact", "[chip]") {
+    // A TP waiting for a known cycle sleeps in a wheel of at most 1024 slots; longer waits go
+    // round it. Two TPs, so one sleeps while the other runs.
+    ChipConfig c = one_tp();
+    c.chip.tps_per_tm = 2;
+    c.icache.threads_per_icache = 2;
+    c.fu.fp_mul.latency = 5000;
+    c.tp.branch_taken_penalty = 1000;
+    Script s(2);
+    for (int i = 0; i < 3; ++i) s.add(0, Op::fmul_s, f(1), f(1), f(2));  // f1 = f1 * f2
+    s.add(1, Op::beq, isa::kNoReg, x(1), x(2), 0, true);
+    s.add(1, Op::add, x(3), x(1), x(2));
+    s.finish();
+    Chip chip(c, s);
+    stats::Registry r;
+    chip.register_stats(r);
+    // TP 0: fmuls at 0, 5000, 10000, its ecall at 10001. TP 1: beq at 0, add at 1001, ecall.
+    CHECK(chip.run() == 2 * 5000 + 2);
+    CHECK(stat(r, "tm0/stalls/operand_from/fp_mul") == 2 * 4999);
+    CHECK(stat(r, "tm0/stalls/branch") == 1000);
+    CHECK(stat(r, "tm0/instructions") == 3 + 1 + 2 + 1);
+}
+
 TEST_CASE("taken branches cost the configured penalty", "[chip]") {
     ChipConfig c = one_tp();
     c.tp.branch_taken_penalty = 3;
