@@ -70,6 +70,7 @@ Decoded decode(uint32_t word) {
         // Rounding modes 5 and 6 are reserved: the encoding is illegal.
         if (ops.rounding_mode && (rm == 5 || rm == 6)) return d;
         d.op = Op(i);
+        d.fu = insn.fu;
         d.rd = unified(bits(word, 11, 7), ops.rd, true);
         d.rs1 = unified(bits(word, 19, 15), ops.rs1, false);
         d.rs2 = unified(bits(word, 24, 20), ops.rs2, false);

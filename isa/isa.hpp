@@ -45,7 +45,9 @@ std::string_view to_string(FuClass fu);
 constexpr uint8_t kFpBase = 32;
 constexpr uint8_t kSink = 64;
 constexpr uint8_t kNumRegs = 65;
-constexpr uint8_t kNoReg = 0xFF;  ///< operand slot unused
+/// An unused operand slot: the index just past the file, so a scoreboard with one extra
+/// always-ready entry reads every slot without a branch.
+constexpr uint8_t kNoReg = kNumRegs;
 
 /// A pre-decoded instruction: decode once, execute many times.
 struct Decoded {
@@ -56,6 +58,7 @@ struct Decoded {
     uint8_t rs3 = kNoReg;
     uint8_t rm = 0;        ///< FP rounding-mode field (7 = dynamic)
     uint8_t zimm = 0;      ///< 5-bit unsigned immediate of csrrwi/csrrsi/csrrci
+    FuClass fu = FuClass::System;  ///< info(op).fu, here so the timing model reads it per issue
     int32_t imm = 0;       ///< sign-extended immediate; CSR number for Zicsr; shamt for shifts;
                            ///< fm|pred|succ for fence
 };

@@ -7,6 +7,7 @@
 // occupy a bank. Data values are never stored: the functional core owns them.
 #pragma once
 #include "stats/registry.hpp"
+#include "timing/bits.hpp"
 #include "timing/config.hpp"
 #include "timing/memory.hpp"
 
@@ -122,19 +123,29 @@ public:
 
     ICacheBanks(const ICacheConfig& config, uint32_t num_threads);
 
-    /// Thread `tp` fetches `pc` in cycle `now`; false = conflict, try again next cycle.
-    /// Within a cycle, earlier callers win: the caller decides the (rotating) order.
-    bool fetch(uint64_t now, uint32_t tp, uint32_t pc) {
-        // No division per fetch (once per simulated instruction): the thread's first bank is
-        // precomputed, and a power-of-two bank count is a mask.
-        Bank& bank = banks_[first_bank_[tp] + bank_mod_.of(pc / 4)];
-        // Written without branches (bitwise | and a mask, which compilers keep branch-free):
-        // whether a fetch conflicts is unpredictable for the host.
-        const bool granted = (bank.cycle != now) | (bank.pc == pc);
-        bank.cycle = now;
-        bank.pc ^= (bank.pc ^ pc) & -uint32_t{granted};
-        counters_.conflicts += !granted;
-        counters_.fetches += granted;
+    /// Threads first_tp + b, for each set bit b of `wanting`, fetch pc_of(thread) in cycle
+    /// `now`, lowest bit first: within a cycle earlier fetches win, so the caller decides the
+    /// (rotating) order. Returns the granted bits; the others conflict and try again next cycle.
+    template <class PcOf>
+    uint64_t fetch(uint64_t now, uint32_t first_tp, uint64_t wanting, PcOf&& pc_of) {
+        // Once per simulated instruction: no division (the thread's first bank is precomputed,
+        // a power-of-two bank count is a mask), and no branch on whether a fetch conflicts,
+        // which is unpredictable for the host.
+        const uint32_t* first_bank = first_bank_.data();
+        Bank* banks = banks_.data();
+        uint64_t granted = 0;
+        for (uint64_t bits = wanting; bits != 0; bits &= bits - 1) {
+            const uint32_t bit = static_cast<uint32_t>(std::countr_zero(bits));
+            const uint32_t tp = first_tp + bit;
+            const uint32_t pc = pc_of(tp);
+            Bank& bank = banks[first_bank[tp] + bank_mod_.of(pc / 4)];
+            const bool ok = (bank.cycle != now) | (bank.pc == pc);
+            bank.cycle = now;
+            bank.pc ^= (bank.pc ^ pc) & -uint32_t{ok};
+            granted |= uint64_t{ok} << bit;
+        }
+        counters_.fetches += count_bits(granted);
+        counters_.conflicts += count_bits(wanting & ~granted);
         return granted;
     }
 

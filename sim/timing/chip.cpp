@@ -1,6 +1,7 @@
 #include "chip.hpp"
 
 #include "kernel/memory_map.hpp"
+#include "timing/bits.hpp"
 #include "timing/machine_source.hpp"
 
 #include <fmt/format.h>
@@ -21,42 +22,6 @@ constexpr size_t kStalls = static_cast<size_t>(Stall::Count);
 
 bool is_local(uint32_t addr) { return addr >= trax::map::kLocalTop - trax::map::kStackGuard; }
 
-void set_bit(std::vector<uint64_t>& bits, uint32_t i) { bits[i >> 6] |= uint64_t{1} << (i & 63); }
-void clear_bit(std::vector<uint64_t>& bits, uint32_t i) {
-    bits[i >> 6] &= ~(uint64_t{1} << (i & 63));
-}
-
-/// std::popcount, inline: built for the x86-64 baseline (no POPCNT instruction), GCC calls
-/// libgcc for it, several times per TM and cycle.
-constexpr uint32_t count_bits(uint64_t x) {
-    x -= (x >> 1) & 0x5555'5555'5555'5555;
-    x = (x & 0x3333'3333'3333'3333) + ((x >> 2) & 0x3333'3333'3333'3333);
-    x = (x + (x >> 4)) & 0x0f0f'0f0f'0f0f'0f0f;
-    return static_cast<uint32_t>((x * 0x0101'0101'0101'0101) >> 56);
-}
-static_assert(count_bits(0) == 0 && count_bits(~uint64_t{0}) == 64 && count_bits(0x8001) == 2);
-
-/// Calls f(word_index, mask) so that the masks' bits, taken in order, visit every bit index in
-/// rotating order: start, start + 1, ..., wrapping to 0. The first word comes twice: its bits
-/// from `start` up first, the ones below last.
-template <class F>
-void for_each_rotated_part(uint32_t words, uint32_t start, F&& f) {
-    const uint32_t first_word = start >> 6;
-    const uint64_t below_start = (uint64_t{1} << (start & 63)) - 1;
-    f(first_word, ~below_start);
-    for (uint32_t k = 1, w = first_word; k < words; ++k) {
-        w = w + 1 == words ? 0 : w + 1;
-        f(w, ~uint64_t{0});
-    }
-    f(first_word, below_start);
-}
-
-/// Calls f(i) for each set bit of `word`, lowest first; i counts from bit 0 of word `w`.
-template <class F>
-void for_each_bit(uint32_t w, uint64_t word, F&& f) {
-    for (; word != 0; word &= word - 1) f((w << 6) + static_cast<uint32_t>(std::countr_zero(word)));
-}
-
 /// The longest a TP can sleep until a known cycle: an operand wait (at most the longest FU
 /// latency plus the local-store latency) or a branch bubble.
 uint64_t longest_timed_sleep(const ChipConfig& c) {
@@ -75,16 +40,14 @@ struct Chip::Tm {
     struct Tp {
         StepInfo pending;            // fetched, not yet issued (bit in pending_tps)
         Pool pending_pool{};
-        isa::FuClass pending_class{};
-        std::array<uint8_t, 4> pending_regs{};  // rs1, rs2, rs3, rd; kNoReg as kNumRegs
         Pool asleep_on{};            // the producing pool a reply-wait is attributed to
         uint64_t wake_at = 0;        // asleep until this cycle (kNever: until a reply for it)
         uint64_t asleep_from = 0;    // first uncounted cycle of a reply-wait
         uint64_t mem_at = 0;         // a granted load/store's first cycle at the L1
         MemRequest mem_request;
         uint32_t lowest_local = trax::map::kLocalTop;  // for the local-store high-water mark
-        // Cycle each register becomes readable; the extra last slot stands for kNoReg (an
-        // unused operand) and stays 0, so the scoreboard check needs no branch per operand.
+        // Cycle each register becomes readable; the extra last slot is isa::kNoReg (an unused
+        // operand) and stays 0, so the scoreboard check needs no branch per operand.
         std::array<uint64_t, isa::kNumRegs + 1> reg_ready{};
         std::array<Pool, isa::kNumRegs> reg_producer{};   // pool that will write it
     };
@@ -180,10 +143,7 @@ Chip::Chip(const ChipConfig& config, InstructionSource& source)
       dram_(config.dram, config.l2.line_bytes),
       global_registers_(config.global_registers) {
     validate(config_);
-    for (size_t op = 0; op < class_of_.size(); ++op) {
-        class_of_[op] = isa::info(isa::Op(op)).fu;
-        pool_of_[op] = pool_of(class_of_[op]);
-    }
+    for (size_t fu = 0; fu < pool_of_.size(); ++fu) pool_of_[fu] = pool_of(isa::FuClass(fu));
     for (uint32_t t = 0; t < config.chip.num_tms; ++t) {
         tms_.push_back(std::make_unique<Tm>(config, t));
         tms_.back()->running = config.chip.tps_per_tm;
@@ -319,28 +279,24 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
     auto& counters = tm.counters;
     for_each_rotated_part(tm.words, tm.rotation, [&](uint32_t w, uint64_t part) {
         const uint64_t fetching = tm.awake_tps[w] & part & ~tm.pending_tps[w];
-        uint64_t fetched = 0;
-        for_each_bit(w, fetching, [&](uint32_t i) {
-            fetched |= uint64_t{tm.icache.fetch(now, i, source.next_pc(first_thread + i))} << (i & 63);
-        });
+        const uint64_t fetched = tm.icache.fetch(
+            now, w << 6, fetching, [&](uint32_t i) { return source.next_pc(first_thread + i); });
         counters.stalls[size_t(Stall::FetchConflict)] += count_bits(fetching & ~fetched);
+        uint64_t needs_port = 0;
         for_each_bit(w, fetched, [&](uint32_t i) {
             Tm::Tp& tp = tps[i];
             source.step(first_thread + i, tp.pending);
-            const isa::Decoded& d = *tp.pending.insn;
-            tp.pending_class = class_of_[size_t(d.op)];
-            tp.pending_pool = pool_of_[size_t(d.op)];
-            // rd too: no write-after-write reorder. kNoReg maps to the always-ready last slot.
-            tp.pending_regs = {std::min(d.rs1, isa::kNumRegs), std::min(d.rs2, isa::kNumRegs),
-                               std::min(d.rs3, isa::kNumRegs), std::min(d.rd, isa::kNumRegs)};
-            const bool needs_port =  // bitwise &: no branch on an unpredictable outcome
+            tp.pending_pool = pool_of_[size_t(tp.pending.insn->fu)];
+            const bool global_access =  // bitwise &: no branch on an unpredictable outcome
                 (tp.pending_pool == Pool::LoadStore) & !is_local(tp.pending.mem_address);
-            tm.needs_port_tps[w] |= uint64_t{needs_port} << (i & 63);
+            needs_port |= uint64_t{global_access} << (i & 63);
         });
+        tm.needs_port_tps[w] |= needs_port;
         tm.pending_tps[w] |= fetched;
     });
 
     uint32_t requested_pools = 0;  // bit per pool with a request this cycle
+    std::array<uint32_t, kPools> requests{};  // requests per pool this cycle
     for (uint32_t w = 0; w < tm.words; ++w) {
         const uint64_t visiting = tm.awake_tps[w];
         counters.active_tp_cycles += count_bits(visiting);
@@ -349,18 +305,20 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
         const uint64_t holding = visiting & tm.pending_tps[w];
         uint64_t ready = 0;
         for_each_bit(w, holding, [&](uint32_t i) {
-            const Tm::Tp& tp = tps[i];
-            const auto ready_at = [&](size_t slot) { return tp.reg_ready[tp.pending_regs[slot]]; };
+            const isa::Decoded& d = *tps[i].pending.insn;
+            const uint64_t* at = tps[i].reg_ready.data();
             const uint64_t operands_at =
-                std::max(std::max(ready_at(0), ready_at(1)), std::max(ready_at(2), ready_at(3)));
+                std::max(std::max(at[d.rs1], at[d.rs2]), std::max(at[d.rs3], at[d.rd]));
             ready |= uint64_t{operands_at <= now} << (i & 63);
         });
         for_each_bit(w, holding & ~ready, [&](uint32_t i) {
             Tm::Tp& tp = tps[i];
+            const isa::Decoded& d = *tp.pending.insn;
+            const std::array<uint8_t, 4> regs = {d.rs1, d.rs2, d.rs3, d.rd};
             uint64_t operands_at = 0;
-            for (uint8_t r : tp.pending_regs) operands_at = std::max(operands_at, tp.reg_ready[r]);
+            for (uint8_t r : regs) operands_at = std::max(operands_at, tp.reg_ready[r]);
             Pool blocking = Pool::IntAlu;  // producer of the first operand that is ready last
-            for (uint8_t r : tp.pending_regs)
+            for (uint8_t r : regs)
                 if (r != isa::kNumRegs && tp.reg_ready[r] == operands_at) {
                     blocking = tp.reg_producer[r];
                     break;
@@ -384,25 +342,28 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
         // has not reached its L1 bank.
         const uint64_t port_busy = ready & tm.needs_port_tps[w] & tm.mem_waiting_tps[w];
         counters.stalls[size_t(Stall::MemoryPort)] += count_bits(port_busy);
+        std::array<uint64_t, kPools> asking{};  // this word's requesters, by pool
         for_each_bit(w, ready & ~port_busy, [&](uint32_t i) {
-            const Pool pool = tps[i].pending_pool;
-            tm.pools[size_t(pool)].request(i);
-            requested_pools |= 1u << size_t(pool);
+            asking[size_t(tps[i].pending_pool)] |= uint64_t{1} << (i & 63);
         });
+        for (size_t p = 0; p < kPools; ++p)
+            if (asking[p] != 0) {
+                tm.pools[p].request(w, asking[p]);
+                requests[p] += count_bits(asking[p]);
+                requested_pools |= 1u << p;
+            }
     }
 
     // Requests the pools refuse are the FU-busy stalls (the TP keeps its instruction).
     for (; requested_pools != 0; requested_pools &= requested_pools - 1) {
         const auto p = static_cast<size_t>(std::countr_zero(requested_pools));
         const Pool pool = Pool(p);
-        counters.stalls[size_t(Stall::FuBusy)] += tm.pools[p].arbitrate(now, [&](uint32_t i, uint64_t ready) {
+        const uint32_t denied = tm.pools[p].arbitrate(now, [&](uint32_t i, uint64_t ready) {
             Tm::Tp& tp = tps[i];
             const StepInfo& s = tp.pending;
             const isa::Decoded& d = *s.insn;
-            const isa::FuClass fu = tp.pending_class;
-            ++counters.instructions;
+            const isa::FuClass fu = d.fu;
             ++counters.per_class[size_t(fu)];
-            ++progress_;
             uint64_t result_at = ready;
             if (fu == isa::FuClass::Atomic) {
                 result_at = kNever;  // set by the global-register reply
@@ -437,6 +398,9 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
                 }
             }
         });
+        counters.stalls[size_t(Stall::FuBusy)] += denied;
+        counters.instructions += requests[p] - denied;
+        progress_ += requests[p] - denied;
     }
     tm.rotation = tm.rotation + 1 == n ? 0 : tm.rotation + 1;
 }

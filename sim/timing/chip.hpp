@@ -86,8 +86,7 @@ private:
     std::vector<Cache> l2s_;
     Dram dram_;
     GlobalRegisterUnit global_registers_;
-    std::array<isa::FuClass, size_t(isa::Op::Count)> class_of_{};  // decoded once, not per issue
-    std::array<Pool, size_t(isa::Op::Count)> pool_of_{};
+    std::array<Pool, size_t(isa::FuClass::Count)> pool_of_{};
     uint64_t cycles_ = 0;
     uint64_t progress_ = 0;  // bumped whenever anything issues or returns
     uint64_t local_store_high_water_ = 0;  // bytes, max over threads

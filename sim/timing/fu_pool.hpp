@@ -4,6 +4,7 @@
 #pragma once
 #include "isa/isa.hpp"
 #include "stats/registry.hpp"
+#include "timing/bits.hpp"
 #include "timing/config.hpp"
 
 #include <algorithm>
@@ -32,10 +33,11 @@ public:
 
     FuPool(const FuConfig& config, uint32_t num_requesters);
 
-    /// Requester `id` wants a unit this cycle. Call before arbitrate(), at most once per id.
-    void request(uint32_t id) {
-        requested_[id >> 6] |= uint64_t{1} << (id & 63);
-        ++requests_;
+    /// Requesters 64 * word + b, for each set bit b of `ids`, want a unit this cycle. Call
+    /// before arbitrate(), at most once per requester.
+    void request(uint32_t word, uint64_t ids) {
+        requested_[word] |= ids;
+        requests_ += count_bits(ids);
     }
 
     /// Grants free units to this cycle's requests in rotating-priority order, calling

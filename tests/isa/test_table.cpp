@@ -48,6 +48,7 @@ TEST_CASE("every instruction decodes back to itself from random operand fields",
                 continue;
             }
             REQUIRE(d.op == op);
+            CHECK(d.fu == insn.fu);
             const uint32_t rd = word >> 7 & 31, rs1 = word >> 15 & 31, rs2 = word >> 20 & 31;
             auto expect = [](RegKind kind, uint32_t field, bool destination) -> uint8_t {
                 if (kind == RegKind::None) return kNoReg;
@@ -64,6 +65,7 @@ TEST_CASE("every instruction decodes back to itself from random operand fields",
 
 TEST_CASE("decoder rejects what is not RV32IMF + tpsim", "[isa][decode]") {
     CHECK(decode(0x0000'0000).op == Op::Illegal); // all-zero word: defined illegal
+    CHECK(decode(0x0000'0000).fu == info(Op::Illegal).fu);
     CHECK(decode(0xffff'ffff).op == Op::Illegal); // all-ones word: defined illegal
     CHECK(decode(0x0200'1013).op == Op::Illegal); // slli with shamt[5]=1 is RV64 only
     CHECK(decode(0x0000'3003).op == Op::Illegal); // ld (RV64)

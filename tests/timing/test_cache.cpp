@@ -125,12 +125,26 @@ TEST_CASE("stores are write-around: forwarded, never allocated, no reply", "[cac
 TEST_CASE("I-cache banks: one address per bank per cycle, shared addresses broadcast",
           "[icache]") {
     ICacheBanks icache(ICacheConfig{16, 4}, 32);
-    CHECK(icache.fetch(0, 0, 0x1000));
-    CHECK(icache.fetch(0, 1, 0x1000));        // same address: broadcast
-    CHECK_FALSE(icache.fetch(0, 2, 0x1010));  // same bank (word 4 % 4), other address
-    CHECK(icache.fetch(0, 3, 0x1004));        // other bank
-    CHECK(icache.fetch(0, 16, 0x1010));       // thread 16 uses the second I-cache
-    CHECK(icache.fetch(1, 2, 0x1010));        // next cycle
+    auto fetch = [&](uint64_t now, uint32_t tp, uint32_t pc) {
+        return icache.fetch(now, tp, 1, [&](uint32_t thread) { return thread == tp ? pc : 0; }) == 1;
+    };
+    CHECK(fetch(0, 0, 0x1000));
+    CHECK(fetch(0, 1, 0x1000));        // same address: broadcast
+    CHECK_FALSE(fetch(0, 2, 0x1010));  // same bank (word 4 % 4), other address
+    CHECK(fetch(0, 3, 0x1004));        // other bank
+    CHECK(fetch(0, 16, 0x1010));       // thread 16 uses the second I-cache
+    CHECK(fetch(1, 2, 0x1010));        // next cycle
     CHECK(icache.counters().conflicts == 1);
     CHECK(icache.counters().fetches == 5);
+}
+
+TEST_CASE("I-cache banks: a set of threads fetches lowest bit first", "[icache]") {
+    ICacheBanks icache(ICacheConfig{16, 4}, 32);
+    // Threads 4..7 all want bank 0; 4 and 6 the same address: 4 wins, 6 shares it.
+    const uint32_t pcs[] = {0x1000, 0x1010, 0x1000, 0x1020};
+    const uint64_t granted =
+        icache.fetch(0, 4, 0b1111, [&](uint32_t thread) { return pcs[thread - 4]; });
+    CHECK(granted == 0b0101);
+    CHECK(icache.counters().fetches == 2);
+    CHECK(icache.counters().conflicts == 2);
 }

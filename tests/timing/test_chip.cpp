@@ -27,11 +27,11 @@ public:
 
     Script& add(uint32_t thread, Op op, uint8_t rd, uint8_t rs1 = isa::kNoReg,
                 uint8_t rs2 = isa::kNoReg, uint32_t mem_address = 0, bool taken = false) {
-        decoded_.push_back({op, rd, rs1, rs2});
+        const auto fu = isa::info(op).fu;
+        decoded_.push_back({.op = op, .rd = rd, .rs1 = rs1, .rs2 = rs2, .fu = fu});
         StepInfo s;
         s.pc = 0x10000 + 4 * uint32_t(trace_[thread].size());
         s.insn = &decoded_.back();
-        const auto fu = isa::info(op).fu;
         if (fu == isa::FuClass::Load || fu == isa::FuClass::Store) {
             s.mem_address = mem_address;
             s.mem_bytes = 4;

@@ -12,7 +12,8 @@ namespace {
 std::vector<uint64_t> saturate(FuPool& pool, uint32_t requesters, uint64_t cycles) {
     std::vector<uint64_t> grants(requesters, 0);
     for (uint64_t now = 0; now < cycles; ++now) {
-        for (uint32_t id = 0; id < requesters; ++id) pool.request(id);
+        for (uint32_t id = 0; id < requesters; ++id)
+            pool.request(id / 64, uint64_t{1} << (id % 64));
         pool.arbitrate(now, [&](uint32_t id, uint64_t ready) {
             CHECK(ready == now + pool.config().latency);
             ++grants[id];
@@ -47,8 +48,7 @@ TEST_CASE("a blocking pool is busy for its latency", "[fu]") {
 TEST_CASE("fewer requests than units are all granted at once", "[fu]") {
     FuPool pool(FuConfig{4, 1, true}, 32);
     std::vector<uint32_t> granted;
-    pool.request(30);
-    pool.request(2);
+    pool.request(0, uint64_t{1} << 30 | uint64_t{1} << 2);  // two requesters in one call
     pool.arbitrate(7, [&](uint32_t id, uint64_t ready) {
         granted.push_back(id);
         CHECK(ready == 8);
@@ -61,9 +61,9 @@ TEST_CASE("rotating priority: the last winner goes to the back", "[fu]") {
     FuPool pool(FuConfig{1, 1, true}, 3);
     std::vector<uint32_t> order;
     for (uint64_t now = 0; now < 6; ++now) {
-        pool.request(2);  // request order must not matter
-        pool.request(0);
-        pool.request(1);
+        pool.request(0, uint64_t{1} << 2);  // request order must not matter
+        pool.request(0, uint64_t{1} << 0);
+        pool.request(0, uint64_t{1} << 1);
         pool.arbitrate(now, [&](uint32_t id, uint64_t) { order.push_back(id); });
     }
     CHECK(order == std::vector<uint32_t>{0, 1, 2, 0, 1, 2});
