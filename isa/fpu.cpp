@@ -101,36 +101,125 @@ template <class Op> uint32_t binary(uint32_t a, uint32_t b, unsigned rm, uint32_
 
 } // namespace
 
-uint32_t add(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags) {
+uint32_t reference::add(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags) {
     return binary(a, b, rm, fflags, [](auto x, auto y) { return x + y; });
 }
 
-uint32_t sub(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags) {
+uint32_t reference::sub(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags) {
     return binary(a, b, rm, fflags, [](auto x, auto y) { return x - y; });
 }
 
-uint32_t mul(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags) {
+uint32_t reference::mul(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags) {
     return binary(a, b, rm, fflags, [](auto x, auto y) { return x * y; });
 }
 
-uint32_t div(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags) {
+uint32_t reference::div(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags) {
     return binary(a, b, rm, fflags, [](auto x, auto y) { return x / y; });
 }
 
-uint32_t sqrt(uint32_t a, unsigned rm, uint32_t& fflags) {
+uint32_t reference::sqrt(uint32_t a, unsigned rm, uint32_t& fflags) {
     const float x = as_float(a);
     return rounded(
         rm, fflags, [&] { return std::sqrt(opaque(x)); },
         [&] { return std::sqrt(opaque(double(x))); });
 }
 
-uint32_t fma(uint32_t a, uint32_t b, uint32_t c, unsigned rm, uint32_t& fflags) {
+uint32_t reference::fma(uint32_t a, uint32_t b, uint32_t c, unsigned rm, uint32_t& fflags) {
     const float x = as_float(a), y = as_float(b), z = as_float(c);
     // RISC-V requires NV for inf*0 even when the addend is a quiet NaN (IEEE leaves it open).
     if (((std::isinf(x) && y == 0) || (x == 0 && std::isinf(y))) && std::isnan(z)) fflags |= NV;
     return rounded(
         rm, fflags, [&] { return std::fma(opaque(x), opaque(y), opaque(z)); },
         [&] { return std::fma(opaque(double(x)), opaque(double(y)), opaque(double(z))); });
+}
+
+namespace {
+
+/// Whether a result rounded in the host default mode, RNE, needs no flag but NX: it is finite,
+/// normal and above the smallest normal (biased exponent 2..254). Then OF is impossible (finite
+/// at RNE), UF too (the exact value exceeds 2^-126: not tiny), and NV and DZ give only NaN or
+/// infinity. 2^-126 itself is left to MXCSR: a tiny exact value can round up to it and raise UF.
+bool flags_at_most_nx(float result) {
+    return ((std::bit_cast<uint32_t>(result) >> 23) & 0xff) - 2 < 0xfd;
+}
+
+/// Knuth's TwoSum: the exact rounding error of s = x + y, in round-to-nearest without overflow.
+template <class T> T sum_error(T x, T y, T s) {
+    const T y_part = s - x, x_part = s - y_part;
+    return (x - x_part) + (y - y_part);
+}
+
+uint32_t nearest(float result, bool inexact, uint32_t& fflags) {
+    if (inexact) fflags |= NX;
+    return std::bit_cast<uint32_t>(result);
+}
+
+} // namespace
+
+// RNE fast paths. The host MXCSR is at its default whenever fpu code runs (run_rounded leaves it
+// there), so plain host arithmetic already rounds RNE; when flags_at_most_nx holds, NX is decided
+// by an exact test below and MXCSR is never touched. Other results and modes take the exact path.
+
+uint32_t add(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags) {
+    if (rm == RNE) [[likely]] {
+        const float x = opaque(as_float(a)), y = opaque(as_float(b)), s = x + y;
+        if (flags_at_most_nx(s)) [[likely]]
+            return nearest(s, sum_error(x, y, s) != 0, fflags);
+    }
+    return reference::add(a, b, rm, fflags);
+}
+
+uint32_t sub(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags) {
+    if (rm == RNE) [[likely]] {
+        const float x = opaque(as_float(a)), y = -opaque(as_float(b)), s = x + y;
+        if (flags_at_most_nx(s)) [[likely]]
+            return nearest(s, sum_error(x, y, s) != 0, fflags);
+    }
+    return reference::sub(a, b, rm, fflags);
+}
+
+// A product of two floats has at most 48 significant bits and an exponent within double's normal
+// range, so it is exact in double: x * y, r * y (for r = x / y) and r * r (for r = sqrt(x)).
+
+uint32_t mul(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags) {
+    if (rm == RNE) [[likely]] {
+        const float x = opaque(as_float(a)), y = opaque(as_float(b)), r = x * y;
+        if (flags_at_most_nx(r)) [[likely]]
+            return nearest(r, double(r) != double(x) * double(y), fflags);
+    }
+    return reference::mul(a, b, rm, fflags);
+}
+
+uint32_t div(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags) {
+    if (rm == RNE) [[likely]] {
+        const float x = opaque(as_float(a)), y = opaque(as_float(b)), r = x / y;
+        if (flags_at_most_nx(r)) [[likely]]
+            return nearest(r, double(r) * double(y) != double(x), fflags);
+    }
+    return reference::div(a, b, rm, fflags);
+}
+
+uint32_t sqrt(uint32_t a, unsigned rm, uint32_t& fflags) {
+    if (rm == RNE) [[likely]] {
+        const float x = opaque(as_float(a)), r = std::sqrt(x);
+        if (flags_at_most_nx(r)) [[likely]]
+            return nearest(r, double(r) * double(r) != double(x), fflags);
+    }
+    return reference::sqrt(a, rm, fflags);
+}
+
+uint32_t fma(uint32_t a, uint32_t b, uint32_t c, unsigned rm, uint32_t& fflags) {
+    if (rm == RNE) [[likely]] {
+        const float x = opaque(as_float(a)), y = opaque(as_float(b)), z = opaque(as_float(c));
+        const float r = std::fma(x, y, z);
+        if (flags_at_most_nx(r)) [[likely]] {
+            // x * y is exact in double and TwoSum splits p + z exactly into s + e (no overflow:
+            // |p + z| < 2^257), so the result r is exact iff s == r and e == 0.
+            const double p = double(x) * double(y), s = p + double(z);
+            return nearest(r, s != double(r) || sum_error(p, double(z), s) != 0, fflags);
+        }
+    }
+    return reference::fma(a, b, c, rm, fflags);
 }
 
 uint32_t cvt_s_w(int32_t a, unsigned rm, uint32_t& fflags) {

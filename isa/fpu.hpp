@@ -17,6 +17,8 @@ constexpr uint32_t kSignBit = 0x8000'0000;
 constexpr uint32_t kCanonicalNaN = 0x7fc0'0000;
 
 // Rounding arithmetic. rm must be 0..4 (already resolved); flags are OR-ed into `fflags`.
+// At RNE, add/sub/mul/div/sqrt/fma take a fast path that leaves MXCSR alone when the result is
+// a normal above 2^-126 (see fpu.cpp); everything else goes to the exact MXCSR path, `reference`.
 uint32_t add(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags);
 uint32_t sub(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags);
 uint32_t mul(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags);
@@ -24,6 +26,15 @@ uint32_t div(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags);
 uint32_t sqrt(uint32_t a, unsigned rm, uint32_t& fflags);
 /// a*b + c rounded once; the fmsub/fnm* variants pass a and/or c with the sign bit flipped.
 uint32_t fma(uint32_t a, uint32_t b, uint32_t c, unsigned rm, uint32_t& fflags);
+namespace reference {
+/// The exact MXCSR path for every operand and mode: the fast paths' fallback and test oracle.
+uint32_t add(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags);
+uint32_t sub(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags);
+uint32_t mul(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags);
+uint32_t div(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags);
+uint32_t sqrt(uint32_t a, unsigned rm, uint32_t& fflags);
+uint32_t fma(uint32_t a, uint32_t b, uint32_t c, unsigned rm, uint32_t& fflags);
+} // namespace reference
 uint32_t cvt_s_w(int32_t a, unsigned rm, uint32_t& fflags);
 uint32_t cvt_s_wu(uint32_t a, unsigned rm, uint32_t& fflags);
 /// Float to integer: rounds per rm, saturates out-of-range values (NaN -> largest) with NV.

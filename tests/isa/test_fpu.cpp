@@ -2,6 +2,8 @@
 // RISC-V unprivileged spec (ch. 11) and IEEE 754-2008; the derivation is in the comment.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -293,5 +295,128 @@ TEST_CASE("fmul.s rounds correctly in every mode on random operands", "[isa][fpu
         CHECK(std::bit_cast<float>(fp(Op::fmul_s, a, b, RMM).value) == (tie ? away : nearer));
         // Inexact exactly when the two directed results differ.
         CHECK(bool(fp(Op::fmul_s, a, b, RMM).flags & NX) == (down != up));
+    }
+}
+
+namespace {
+
+/// Operands for the fast-path equivalence test below.
+class Operands {
+  public:
+    explicit Operands(uint32_t seed) : rng_(seed) {}
+    int pick(int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng_); }
+    uint32_t uniform() { return uint32_t(rng_()); }
+    /// Random sign, biased exponent clamped to 0..254 (0: subnormal or zero), random significand
+    /// with a random number of trailing zeros so that exact results are common.
+    uint32_t with_exponent(int exponent) {
+        const uint32_t significand = uniform() & 0x7f'ffff & (~0u << pick(0, 23));
+        return (uniform() & kSignBit) | uint32_t(std::clamp(exponent, 0, 254)) << 23 | significand;
+    }
+    /// Small integers and powers of two: exact sums, products and quotients.
+    uint32_t simple() {
+        if (pick(0, 1)) return std::bit_cast<uint32_t>(float(pick(-64, 64)));
+        return (uniform() & kSignBit) | uint32_t(pick(100, 154)) << 23;
+    }
+    /// Zeros, infinities, NaNs, subnormals, the normal extremes, one; either sign.
+    uint32_t special() {
+        static constexpr uint32_t kSpecials[] = {kPlusZero,    kInf,    kQNaN,       kSNaN,
+                                                 kPayloadQNaN, kMinSub, 0x007f'ffff, kMinNormal,
+                                                 kMax,         kOne};
+        return (uniform() & kSignBit) | kSpecials[pick(0, std::size(kSpecials) - 1)];
+    }
+
+  private:
+    std::mt19937 rng_;
+};
+
+/// The operations as (a, b, c) functions; unused operands are ignored.
+using Operation = uint32_t (*)(uint32_t, uint32_t, uint32_t, unsigned, uint32_t&);
+template <auto F> uint32_t unary(uint32_t a, uint32_t, uint32_t, unsigned rm, uint32_t& fflags) {
+    return F(a, rm, fflags);
+}
+template <auto F> uint32_t binary(uint32_t a, uint32_t b, uint32_t, unsigned rm, uint32_t& fflags) {
+    return F(a, b, rm, fflags);
+}
+template <auto F>
+uint32_t ternary(uint32_t a, uint32_t b, uint32_t c, unsigned rm, uint32_t& fflags) {
+    return F(a, b, c, rm, fflags);
+}
+
+/// Biased operand exponents that aim the result of an operation at biased exponent e.
+using Aim = std::array<int, 3> (*)(Operands&, int e);
+std::array<int, 3> sum_near(Operands& g, int e) {
+    return {e + g.pick(-2, 2), e + g.pick(-2, 2), 0};
+}
+std::array<int, 3> product_near(Operands& g, int e) { // the third exponent is fma's addend
+    const int ea = g.pick(std::max(0, e - 127), std::min(254, e + 127));
+    return {ea, e - ea + 127 + g.pick(-2, 2), e + g.pick(-2, 2)};
+}
+std::array<int, 3> quotient_near(Operands& g, int e) {
+    const int eb = g.pick(std::max(0, 127 - e), std::min(254, 381 - e));
+    return {e + eb - 127 + g.pick(-2, 2), eb, 0};
+}
+std::array<int, 3> root_near(Operands& g, int e) {
+    return {2 * e - 127 + g.pick(-2, 2), 0, 0};
+}
+
+/// A fast-pathed operation, its exact MXCSR reference, and the flags the operand mix must raise.
+struct FastPathOp {
+    const char* name;
+    Operation fast, reference;
+    Aim aim;
+    uint32_t flags_expected;
+};
+
+const FastPathOp kFastPathOps[] = {
+    {"add", binary<fpu::add>, binary<reference::add>, sum_near, NX | OF | NV},
+    {"sub", binary<fpu::sub>, binary<reference::sub>, sum_near, NX | OF | NV},
+    {"mul", binary<fpu::mul>, binary<reference::mul>, product_near, NX | UF | OF | NV},
+    {"div", binary<fpu::div>, binary<reference::div>, quotient_near, NX | UF | OF | DZ | NV},
+    {"sqrt", unary<fpu::sqrt>, unary<reference::sqrt>, root_near, NX | NV},
+    {"fma", ternary<fpu::fma>, ternary<reference::fma>, product_near, NX | UF | OF | NV},
+};
+
+} // namespace
+
+TEST_CASE("the RNE fast paths agree with the MXCSR path on result and flags",
+          "[isa][fpu][rounding]") {
+    // Hand-derived corner: (1 - 2^-24) * 2^-126 = 2^-126 - 2^-150 ties (bounded exponent) up to
+    // the normal 2^-126, but is tiny before and after rounding: UF | NX, the case the fast path
+    // must leave alone although the result is normal.
+    uint32_t corner_flags = 0;
+    CHECK(fpu::mul(0x3f7f'ffff, kMinNormal, RNE, corner_flags) == kMinNormal);
+    CHECK(corner_flags == (UF | NX));
+    for (const FastPathOp& op : kFastPathOps) {
+        Operands g(2025);
+        uint32_t flags_seen = 0, exact_normal = 0;
+        for (int trial = 0; trial < 200'000; ++trial) {
+            std::array<uint32_t, 3> in{};
+            const int kind = g.pick(0, 5);
+            if (kind == 0 || kind == 5) { // uniform bit patterns; specials mixed into them
+                for (uint32_t& v : in)
+                    v = kind == 5 && g.pick(0, 1) ? g.special() : g.uniform();
+            } else if (kind == 4) {
+                for (uint32_t& v : in)
+                    v = g.simple();
+            } else { // results anywhere (close exponents), near 2^-126 or near FLT_MAX
+                const int target = kind == 1   ? g.pick(1, 254)
+                                   : kind == 2 ? g.pick(0, 3)
+                                               : g.pick(252, 254);
+                const std::array<int, 3> exponents = op.aim(g, target);
+                for (int i = 0; i < 3; ++i)
+                    in[i] = g.with_exponent(exponents[i]);
+            }
+            FpResult fast{}, reference{};
+            fast.value = op.fast(in[0], in[1], in[2], RNE, fast.flags);
+            reference.value = op.reference(in[0], in[1], in[2], RNE, reference.flags);
+            INFO(op.name << std::hex << " 0x" << in[0] << " 0x" << in[1] << " 0x" << in[2]);
+            REQUIRE(fast == reference);
+            flags_seen |= reference.flags;
+            const uint32_t exponent = reference.value >> 23 & 0xff;
+            exact_normal += reference.flags == 0 && exponent != 0 && exponent != 0xff;
+        }
+        INFO(op.name);
+        CHECK(flags_seen == op.flags_expected);
+        CHECK(exact_normal > 5'000); // exact results are common enough to test "no NX"
     }
 }
