@@ -47,32 +47,51 @@ public:
     template <class OnGrant>
     uint32_t arbitrate(uint64_t now, OnGrant&& on_grant) {
         if (requests_ == 0) return 0;
-        // Requests are a bit set, walked from the priority pointer with wrap-around: the
-        // rotating-priority order without sorting.
-        const uint32_t words = static_cast<uint32_t>(requested_.size());
-        const uint32_t first_word = next_priority_ >> 6;
-        const uint64_t below_start = (uint64_t{1} << (next_priority_ & 63)) - 1;
-        uint32_t last_granted = kNone;
-        for (uint32_t k = 0, w = first_word; k <= words; ++k, w = w + 1 == words ? 0 : w + 1) {
-            // The first word is visited twice: its bits from the pointer up, last the ones below.
-            uint64_t bits = requested_[w];
-            if (k == 0) bits &= ~below_start;
-            else if (k == words) bits &= below_start;
-            else if (w == first_word) continue;
-            if (k != 0) requested_[w] = 0;  // its last visit (cleared here: no memset call)
-            for (; bits != 0; bits &= bits - 1) {
-                if (!try_start(now)) break;  // no unit frees up within a cycle: the rest lose too
-                const uint32_t id = (w << 6) + static_cast<uint32_t>(std::countr_zero(bits));
-                on_grant(id, now + config_.latency);
-                last_granted = id;
-                --requests_;
+        // No unit frees up within a cycle, so the winners are the first `granted` requesters
+        // in rotating-priority order.
+        const uint32_t granted = std::min(requests_, free_units(now));
+        const uint32_t denied = requests_ - granted;
+        const uint64_t ready = now + config_.latency;
+        uint32_t last = 0;
+        auto grant = [&](uint32_t id) {
+            if (!config_.pipelined) {
+                uint64_t* unit = unit_free_at_.data();
+                while (*unit > now) ++unit;
+                *unit = ready;  // the first free unit, busy until the result is out
             }
+            on_grant(id, ready);
+            last = id;
+        };
+        if (requested_.size() == 1) {
+            // Up to 64 requesters: the word rotated right by the priority pointer holds the
+            // requests in priority order (no bit at or above num_requesters_ is ever set).
+            const uint32_t start = next_priority_;
+            uint64_t order = std::rotr(requested_[0], static_cast<int>(start));
+            requested_[0] = 0;
+            for (uint32_t left = granted; left != 0; --left, order &= order - 1)
+                grant((static_cast<uint32_t>(std::countr_zero(order)) + start) & 63);
+        } else {
+            // The words walked from the pointer's with wrap-around, the first one twice: its
+            // bits from the pointer up first, the ones below it last.
+            const uint32_t words = static_cast<uint32_t>(requested_.size());
+            const uint32_t first_word = next_priority_ >> 6;
+            const uint64_t below_start = (uint64_t{1} << (next_priority_ & 63)) - 1;
+            uint32_t left = granted;
+            for (uint32_t k = 0, w = first_word; left != 0; ++k, w = w + 1 == words ? 0 : w + 1) {
+                uint64_t bits = requested_[w];
+                if (k == 0) bits &= ~below_start;
+                else if (k == words) bits &= below_start;
+                for (; bits != 0 && left != 0; bits &= bits - 1, --left)
+                    grant((w << 6) + static_cast<uint32_t>(std::countr_zero(bits)));
+            }
+            for (uint64_t& word : requested_) word = 0;
         }
-        const uint32_t denied = requests_;
-        counters_.denied += denied;
-        if (last_granted != kNone)
-            next_priority_ = last_granted + 1 == num_requesters_ ? 0 : last_granted + 1;
         requests_ = 0;
+        counters_.issued += granted;
+        counters_.unit_busy_cycles += uint64_t{granted} * (config_.pipelined ? 1 : config_.latency);
+        counters_.denied += denied;
+        started_ += granted;
+        if (granted != 0) next_priority_ = last + 1 == num_requesters_ ? 0 : last + 1;
         return denied;
     }
 
@@ -81,8 +100,19 @@ public:
     void register_stats(stats::Registry& registry, std::string_view prefix) const;
 
 private:
-    static constexpr uint32_t kNone = UINT32_MAX;
-    bool try_start(uint64_t now);  // inline below: called once per simulated instruction
+    /// Units that can start an operation in cycle `now`.
+    uint32_t free_units(uint64_t now) {
+        if (config_.pipelined) {
+            // Every pipelined unit is free again one cycle after it started, so which unit
+            // takes an operation is unobservable: counting this cycle's starts is enough.
+            started_ = started_cycle_ == now ? started_ : 0;
+            started_cycle_ = now;
+            return config_.count - started_;
+        }
+        uint32_t free = 0;
+        for (uint64_t free_at : unit_free_at_) free += free_at <= now;
+        return free;
+    }
 
     FuConfig config_;
     uint32_t num_requesters_;
@@ -90,30 +120,9 @@ private:
     std::vector<uint64_t> requested_;     // bit per requester, this cycle
     uint32_t requests_ = 0;               // bits set in requested_
     std::vector<uint64_t> unit_free_at_;  // per unit, if not pipelined: first cycle it can start
-    uint64_t starts_cycle_ = UINT64_MAX;  // if pipelined: operations started in cycle starts_cycle_
-    uint32_t starts_ = 0;
+    uint64_t started_cycle_ = UINT64_MAX;  // if pipelined: operations started in started_cycle_
+    uint32_t started_ = 0;
     Counters counters_;
 };
-
-inline bool FuPool::try_start(uint64_t now) {
-    if (config_.pipelined) {
-        // Every pipelined unit is free again one cycle after it started, so which unit takes an
-        // operation is unobservable: counting this cycle's starts is enough.
-        if (starts_cycle_ != now) starts_cycle_ = now, starts_ = 0;
-        if (starts_ == config_.count) return false;
-        ++starts_;
-        ++counters_.issued;
-        ++counters_.unit_busy_cycles;
-        return true;
-    }
-    for (uint64_t& free_at : unit_free_at_) {
-        if (free_at > now) continue;
-        free_at = now + config_.latency;  // not pipelined: busy until the result is out
-        ++counters_.issued;
-        counters_.unit_busy_cycles += config_.latency;
-        return true;
-    }
-    return false;
-}
 
 }  // namespace tpsim::timing
