@@ -64,7 +64,7 @@ struct Chip::Tm {
     Tm(const ChipConfig& c, uint32_t id)
         : id(id), words((c.chip.tps_per_tm + 63) / 64), tps(c.chip.tps_per_tm),
           icache(c.icache, c.chip.tps_per_tm), l1(c.l1), awake_tps(words), pending_tps(words),
-          needs_port_tps(words), mem_waiting_tps(words),
+          needs_port_tps(words), mem_waiting_tps(words), issuing_tps(words),
           wheel_slots(std::min(std::bit_ceil(longest_timed_sleep(c) + 1), kMaxWheelSlots)),
           sleeps_outlast_wheel(longest_timed_sleep(c) >= wheel_slots),
           wheel(wheel_slots * words) {
@@ -128,6 +128,7 @@ struct Chip::Tm {
     TpBits pending_tps;      // holding a fetched instruction
     TpBits needs_port_tps;   // ... that is a load/store to global memory (needs the L1 port)
     TpBits mem_waiting_tps;  // a granted load/store waits for its L1 access
+    TpBits issuing_tps;      // won a unit this cycle
     // Timed sleeps: wheel_slots TpBits (a power of two above the longest sleep, at most
     // kMaxWheelSlots), the one for cycle t at t % wheel_slots.
     static constexpr uint64_t kMaxWheelSlots = 1024;
@@ -144,6 +145,7 @@ Chip::Chip(const ChipConfig& config, InstructionSource& source)
       global_registers_(config.global_registers) {
     validate(config_);
     for (size_t fu = 0; fu < pool_of_.size(); ++fu) pool_of_[fu] = pool_of(isa::FuClass(fu));
+    for (size_t p = 0; p < kPools; ++p) latency_of_[p] = pool_config(config.fu, Pool(p)).latency;
     for (uint32_t t = 0; t < config.chip.num_tms; ++t) {
         tms_.push_back(std::make_unique<Tm>(config, t));
         tms_.back()->running = config.chip.tps_per_tm;
@@ -354,15 +356,23 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             }
     }
 
-    // Requests the pools refuse are the FU-busy stalls (the TP keeps its instruction).
+    // Requests the pools refuse are the FU-busy stalls (the TP keeps its instruction); the
+    // winners of every pool issue in one pass.
     for (; requested_pools != 0; requested_pools &= requested_pools - 1) {
         const auto p = static_cast<size_t>(std::countr_zero(requested_pools));
-        const Pool pool = Pool(p);
-        const uint32_t denied = tm.pools[p].arbitrate(now, [&](uint32_t i, uint64_t ready) {
+        const uint32_t denied = tm.pools[p].arbitrate(now, tm.issuing_tps.data());
+        counters.stalls[size_t(Stall::FuBusy)] += denied;
+        counters.instructions += requests[p] - denied;
+        progress_ += requests[p] - denied;
+    }
+    for (uint32_t w = 0; w < tm.words; ++w) {
+        for_each_bit(w, std::exchange(tm.issuing_tps[w], 0), [&](uint32_t i) {
             Tm::Tp& tp = tps[i];
             const StepInfo& s = tp.pending;
             const isa::Decoded& d = *s.insn;
             const isa::FuClass fu = d.fu;
+            const Pool pool = tp.pending_pool;
+            const uint64_t ready = now + latency_of_[size_t(pool)];
             ++counters.per_class[size_t(fu)];
             uint64_t result_at = ready;
             if (fu == isa::FuClass::Atomic) {
@@ -398,9 +408,6 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
                 }
             }
         });
-        counters.stalls[size_t(Stall::FuBusy)] += denied;
-        counters.instructions += requests[p] - denied;
-        progress_ += requests[p] - denied;
     }
     tm.rotation = tm.rotation + 1 == n ? 0 : tm.rotation + 1;
 }

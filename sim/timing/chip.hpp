@@ -87,6 +87,7 @@ private:
     Dram dram_;
     GlobalRegisterUnit global_registers_;
     std::array<Pool, size_t(isa::FuClass::Count)> pool_of_{};
+    std::array<uint32_t, size_t(Pool::Count)> latency_of_{};
     uint64_t cycles_ = 0;
     uint64_t progress_ = 0;  // bumped whenever anything issues or returns
     uint64_t local_store_high_water_ = 0;  // bytes, max over threads

@@ -40,36 +40,31 @@ public:
         requests_ += count_bits(ids);
     }
 
-    /// Grants free units to this cycle's requests in rotating-priority order, calling
-    /// on_grant(id, ready_cycle) for each winner (ready_cycle = when its result can be read);
-    /// the others are counted as denied and should request again next cycle. Returns how many
-    /// were denied.
-    template <class OnGrant>
-    uint32_t arbitrate(uint64_t now, OnGrant&& on_grant) {
+    /// Grants free units to this cycle's requests in rotating-priority order: the winners'
+    /// bits are OR-ed into `winners` (a word per 64 requesters, as in request()); their results
+    /// can be read at now + latency. The others are denied and should request again next
+    /// cycle. Returns how many were denied.
+    uint32_t arbitrate(uint64_t now, uint64_t* winners) {
         if (requests_ == 0) return 0;
         // No unit frees up within a cycle, so the winners are the first `granted` requesters
         // in rotating-priority order.
         const uint32_t granted = std::min(requests_, free_units(now));
         const uint32_t denied = requests_ - granted;
-        const uint64_t ready = now + config_.latency;
-        uint32_t last = 0;
-        auto grant = [&](uint32_t id) {
-            if (!config_.pipelined) {
-                uint64_t* unit = unit_free_at_.data();
-                while (*unit > now) ++unit;
-                *unit = ready;  // the first free unit, busy until the result is out
-            }
-            on_grant(id, ready);
-            last = id;
-        };
+        uint32_t last = 0;  // the last winner in priority order
         if (requested_.size() == 1) {
             // Up to 64 requesters: the word rotated right by the priority pointer holds the
             // requests in priority order (no bit at or above num_requesters_ is ever set).
-            const uint32_t start = next_priority_;
-            uint64_t order = std::rotr(requested_[0], static_cast<int>(start));
+            const int start = static_cast<int>(next_priority_);
+            uint64_t order = std::rotr(requested_[0], start);
             requested_[0] = 0;
-            for (uint32_t left = granted; left != 0; --left, order &= order - 1)
-                grant((static_cast<uint32_t>(std::countr_zero(order)) + start) & 63);
+            if (denied != 0) {
+                uint64_t first = 0;
+                for (uint32_t left = granted; left != 0; --left, order &= order - 1)
+                    first |= order & -order;
+                order = first;
+            }
+            if (order != 0) last = static_cast<uint32_t>(63 - std::countl_zero(order) + start) & 63;
+            winners[0] |= std::rotl(order, start);
         } else {
             // The words walked from the pointer's with wrap-around, the first one twice: its
             // bits from the pointer up first, the ones below it last.
@@ -81,10 +76,18 @@ public:
                 uint64_t bits = requested_[w];
                 if (k == 0) bits &= ~below_start;
                 else if (k == words) bits &= below_start;
-                for (; bits != 0 && left != 0; bits &= bits - 1, --left)
-                    grant((w << 6) + static_cast<uint32_t>(std::countr_zero(bits)));
+                for (; bits != 0 && left != 0; bits &= bits - 1, --left) {
+                    winners[w] |= bits & -bits;
+                    last = (w << 6) + static_cast<uint32_t>(std::countr_zero(bits));
+                }
             }
             for (uint64_t& word : requested_) word = 0;
+        }
+        if (!config_.pipelined) {
+            // Winners take the first free units, each busy until its result is out.
+            uint32_t left = granted;
+            for (uint64_t& free_at : unit_free_at_)
+                if (left != 0 && free_at <= now) free_at = now + config_.latency, --left;
         }
         requests_ = 0;
         counters_.issued += granted;

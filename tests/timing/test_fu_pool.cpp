@@ -8,16 +8,23 @@ using namespace tpsim::timing;
 
 namespace {
 
-// Every requester asks every cycle; returns grants per requester and checks ready cycles.
+// The requesters that won this cycle, lowest first.
+std::vector<uint32_t> winners_of(FuPool& pool, uint64_t now, uint32_t requesters) {
+    std::vector<uint64_t> words((requesters + 63) / 64, 0);
+    pool.arbitrate(now, words.data());
+    std::vector<uint32_t> ids;
+    for (uint32_t id = 0; id < requesters; ++id)
+        if (words[id / 64] >> (id % 64) & 1) ids.push_back(id);
+    return ids;
+}
+
+// Every requester asks every cycle; returns grants per requester.
 std::vector<uint64_t> saturate(FuPool& pool, uint32_t requesters, uint64_t cycles) {
     std::vector<uint64_t> grants(requesters, 0);
     for (uint64_t now = 0; now < cycles; ++now) {
         for (uint32_t id = 0; id < requesters; ++id)
             pool.request(id / 64, uint64_t{1} << (id % 64));
-        pool.arbitrate(now, [&](uint32_t id, uint64_t ready) {
-            CHECK(ready == now + pool.config().latency);
-            ++grants[id];
-        });
+        for (uint32_t id : winners_of(pool, now, requesters)) ++grants[id];
     }
     return grants;
 }
@@ -45,15 +52,17 @@ TEST_CASE("a blocking pool is busy for its latency", "[fu]") {
     for (uint64_t g : grants) CHECK(g == 20);
 }
 
+TEST_CASE("a pool of more than 64 requesters shares fairly too", "[fu]") {
+    FuPool pool(FuConfig{3, 1, true}, 100);
+    const auto grants = saturate(pool, 100, 100);
+    CHECK(grants == std::vector<uint64_t>(100, 3));
+    CHECK(pool.counters().denied == 100 * 97);
+}
+
 TEST_CASE("fewer requests than units are all granted at once", "[fu]") {
     FuPool pool(FuConfig{4, 1, true}, 32);
-    std::vector<uint32_t> granted;
     pool.request(0, uint64_t{1} << 30 | uint64_t{1} << 2);  // two requesters in one call
-    pool.arbitrate(7, [&](uint32_t id, uint64_t ready) {
-        granted.push_back(id);
-        CHECK(ready == 8);
-    });
-    CHECK(granted.size() == 2);
+    CHECK(winners_of(pool, 7, 32) == std::vector<uint32_t>{2, 30});
     CHECK(pool.counters().denied == 0);
 }
 
@@ -64,9 +73,20 @@ TEST_CASE("rotating priority: the last winner goes to the back", "[fu]") {
         pool.request(0, uint64_t{1} << 2);  // request order must not matter
         pool.request(0, uint64_t{1} << 0);
         pool.request(0, uint64_t{1} << 1);
-        pool.arbitrate(now, [&](uint32_t id, uint64_t) { order.push_back(id); });
+        for (uint32_t id : winners_of(pool, now, 3)) order.push_back(id);
     }
     CHECK(order == std::vector<uint32_t>{0, 1, 2, 0, 1, 2});
+}
+
+TEST_CASE("scarce units go to the first requesters from the priority pointer", "[fu]") {
+    FuPool pool(FuConfig{2, 1, true}, 5);
+    std::vector<std::vector<uint32_t>> rounds;
+    for (uint64_t now = 0; now < 4; ++now) {
+        pool.request(0, 0b11110);  // requesters 1..4
+        rounds.push_back(winners_of(pool, now, 5));
+    }
+    // The pointer starts at 0 and moves past the last winner, wrapping around.
+    CHECK(rounds == std::vector<std::vector<uint32_t>>{{1, 2}, {3, 4}, {1, 2}, {3, 4}});
 }
 
 TEST_CASE("every FU class maps to the pool the milestone names", "[fu]") {
