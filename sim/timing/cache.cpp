@@ -116,13 +116,6 @@ void Cache::fill(uint64_t now, uint32_t line_addr) {
     }
 }
 
-bool Cache::pop_reply(uint64_t now, MemReply& reply) {
-    if (replies_.empty() || replies_.front().ready > now) return false;
-    reply = replies_.front();
-    replies_.pop_front();
-    return true;
-}
-
 void Cache::register_stats(stats::Registry& r, std::string_view prefix) const {
     auto name = [&](std::string_view leaf) { return fmt::format("{}/{}", prefix, leaf); };
     r.add_counter(name("reads"), counters_.reads, "loads accepted", "accesses");

@@ -66,8 +66,13 @@ public:
     /// The line holding `line_addr` arrives from the next level in cycle `now`: it is
     /// installed (evicting the LRU way) and every merged waiter gets a reply at now + hit_latency.
     void fill(uint64_t now, uint32_t line_addr);
-    /// Pops the oldest reply whose data is ready by `now`.
-    bool pop_reply(uint64_t now, MemReply& reply);
+    /// Pops the oldest reply whose data is ready by `now` (inline: asked every TM and cycle).
+    bool pop_reply(uint64_t now, MemReply& reply) {
+        if (replies_.empty() || replies_.front().ready > now) return false;
+        reply = replies_.front();
+        replies_.pop_front();
+        return true;
+    }
 
     /// Requests for the next level in the order they were made; the owner drains it.
     std::deque<OutboundRequest>& outbound() { return outbound_; }
