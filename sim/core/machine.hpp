@@ -77,18 +77,11 @@ class Machine {
     /// Executes one instruction of a running thread and reports what it did. Throws Fault.
     StepRecord step(uint32_t thread);
     /// The timing model's batched step(): executes thread `id`'s next instruction, then the
-    /// following ones while next_is_private(id), at most `capacity` in all (and never past the
-    /// instruction limit), writing their records to out[0..done). If an instruction faults,
-    /// the Fault is thrown with `done` counting the records written before it. Defined in
-    /// thread_env.hpp so the cycle loop can inline it.
+    /// following ones while they are private (is_private), at most `capacity` in all (and
+    /// never past the instruction limit), writing their records to out[0..done). If an
+    /// instruction faults, the Fault is thrown with `done` counting the records written before
+    /// it. Defined in thread_env.hpp so the cycle loop can inline it.
     inline void run_ahead(uint32_t id, StepRecord* out, uint32_t capacity, uint32_t& done);
-
-    /// True if thread `id` is running and its next instruction touches only the thread's own
-    /// state (registers, pc, local store): executing it earlier or later than other threads'
-    /// instructions cannot change any result. False for shared-memory accesses, atomics and
-    /// CSR/system instructions (whose results may depend on when they run). Defined in
-    /// thread_env.hpp.
-    inline bool next_is_private(uint32_t id) const;
 
     /// Timing mode: the cycle/time CSRs read `*cycles` (the chip's current cycle) instead of
     /// instret; nullptr (the default) = functional mode, where cycle = instret. The counter
@@ -119,6 +112,13 @@ class Machine {
     /// others), and an illegal or unimplemented instruction (traps to mtvec or throws).
     bool read_csr(uint32_t id, uint32_t csr, uint32_t& value) const;
     [[gnu::cold]] void illegal(uint32_t id, isa::Hart& h, const isa::Decoded& d);
+    /// True if the instruction at text word `index` (any value: outside the text is not
+    /// private), run by hart `h`, touches only the thread's own state (registers, pc, local
+    /// store) or reads the read-only scene: executing it earlier or later than other threads'
+    /// instructions cannot change any result. False for shared-memory accesses, atomics and
+    /// CSR/system instructions (whose results may depend on when they run). Defined in
+    /// thread_env.hpp.
+    inline bool is_private(const isa::Hart& h, uint32_t index, uint32_t text_words) const;
 
     Program program_;
     MachineConfig config_;
@@ -126,7 +126,7 @@ class Machine {
     uint32_t text_base_ = 0;
     uint32_t text_bytes_ = 0;
     std::vector<isa::Decoded> decoded_; ///< the executable range, one entry per word
-    /// Per word of decoded_: whether the instruction is private (next_is_private): always,
+    /// Per word of decoded_: whether the instruction is private (is_private): always,
     /// never, or depending on the address it loads from or stores to.
     enum class Privacy : uint8_t { Always, Never, Load, Store };
     std::vector<Privacy> privacy_;

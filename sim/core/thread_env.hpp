@@ -125,40 +125,54 @@ template <bool kRecord> class ThreadEnv {
     capacity = uint32_t(std::min<uint64_t>(capacity, config_.max_instructions - t.executed));
     isa::Hart& h = t.hart;
     ThreadEnv<true> env(*this, id, out);
+    // Locals, not members (as in run_quantum): stores through the hart's registers could alias
+    // members, and the compiler would reload them every instruction.
+    uint64_t* per_op = counters_.per_op.data();
+    const isa::Decoded* decoded = decoded_.data();
+    const uint32_t text_base = text_base_;
+    const uint32_t text_words = text_bytes_ / 4;
+    uint32_t n = 0;  // records written
+    const auto count = [&] {
+        done = n;
+        t.executed += n;
+        counters_.instructions += n;
+    };
     uint32_t pc = h.pc;
     try {
-        do {
+        for (;;) {
             pc = h.pc;
-            const uint32_t index = std::rotr(pc - text_base_, 2); // range and alignment, as in run_quantum
-            if (index >= text_bytes_ / 4) [[unlikely]]
+            const uint32_t index = std::rotr(pc - text_base, 2); // range and alignment, as in run_quantum
+            if (index >= text_words) [[unlikely]]
                 fetch_fault(id, pc);
-            const isa::Decoded& d = decoded_[index];
-            ++counters_.per_op[size_t(d.op)];
-            StepRecord& record = out[done];
+            const isa::Decoded& d = decoded[index];
+            ++per_op[size_t(d.op)];
+            StepRecord& record = out[n];
             record = StepRecord{.pc = pc, .insn = &d};
             env.record_into(&record);
             isa::execute(d, h, env);
             record.taken = !record.exited && h.pc != pc + 4;
-            ++done;
-            ++t.executed;
-            ++counters_.instructions;
-        } while (done < capacity && next_is_private(id));
+            // An exited thread's pc is parked outside the code, so it is not private either.
+            if (++n == capacity || !is_private(h, std::rotr(h.pc - text_base, 2), text_words)) break;
+        }
     } catch (const GuestFault& f) {
+        count();
         fault(id, pc, f);
+    } catch (...) {
+        count();
+        throw;
     }
+    count();
 }
 
-inline bool Machine::next_is_private(uint32_t id) const {
-    const Thread& t = threads_[id];
-    const uint32_t index = std::rotr(t.hart.pc - text_base_, 2);
-    if (t.state != ThreadState::Running || index >= text_bytes_ / 4) return false;
+inline bool Machine::is_private(const isa::Hart& h, uint32_t index, uint32_t text_words) const {
+    if (index >= text_words) return false;
     const Privacy privacy = privacy_[index];
     if (privacy == Privacy::Always || privacy == Privacy::Never) return privacy == Privacy::Always;
     // The local store, its overflow guard and the unmapped space above are private: an access
     // there either touches the thread's own store or faults. Loads from read-only memory see
     // the same value whenever they run.
     const isa::Decoded& d = decoded_[index];
-    const uint32_t addr = t.hart.reg[d.rs1] + uint32_t(d.imm);
+    const uint32_t addr = h.reg[d.rs1] + uint32_t(d.imm);
     return addr >= trax::map::kLocalTop - trax::map::kStackGuard ||
            (privacy == Privacy::Load && memory_.in_read_only_global(addr));
 }

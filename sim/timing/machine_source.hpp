@@ -25,7 +25,7 @@ inline core::MachineConfig machine_config_for(const ChipConfig& chip) {
 /// Runs each thread ahead of the chip: when the chip fetches an instruction of a thread with
 /// nothing buffered, that instruction executes (exactly when it is fetched, as the model
 /// requires), and so do the following ones while they are private to the thread
-/// (Machine::next_is_private); the chip then takes their records from the buffer. Instructions
+/// (Machine::is_private); the chip then takes their records from the buffer. Instructions
 /// that see shared state still execute in fetch order and cycle, so results are the same as
 /// executing each at its fetch, while the functional core runs a thread's code in stretches,
 /// which the host's branch predictors handle far better than one instruction per thread in turn.
