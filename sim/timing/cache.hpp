@@ -128,11 +128,12 @@ public:
 
     ICacheBanks(const ICacheConfig& config, uint32_t num_threads);
 
-    /// Threads first_tp + b, for each set bit b of `wanting`, fetch pc_of(thread) in cycle
-    /// `now`, lowest bit first: within a cycle earlier fetches win, so the caller decides the
+    /// Threads tp_of(b), for each set bit b of `wanting`, fetch pc_of(thread) in cycle `now`,
+    /// lowest bit first: within a cycle earlier fetches win, so the caller decides the
     /// (rotating) order. Returns the granted bits; the others conflict and try again next cycle.
-    template <class PcOf>
-    uint64_t fetch(uint64_t now, uint32_t first_tp, uint64_t wanting, PcOf&& pc_of) {
+    template <class TpOf, class PcOf>
+    [[gnu::always_inline]] uint64_t fetch(uint64_t now, uint64_t wanting, TpOf&& tp_of,
+                                          PcOf&& pc_of) {
         // Once per simulated instruction: no division (the thread's first bank is precomputed,
         // a power-of-two bank count is a mask), and no branch on whether a fetch conflicts,
         // which is unpredictable for the host.
@@ -141,7 +142,7 @@ public:
         uint64_t granted = 0;
         for (uint64_t bits = wanting; bits != 0; bits &= bits - 1) {
             const uint32_t bit = static_cast<uint32_t>(std::countr_zero(bits));
-            const uint32_t tp = first_tp + bit;
+            const uint32_t tp = tp_of(bit);
             const uint32_t pc = pc_of(tp);
             Bank& bank = banks[first_bank[tp] + bank_mod_.of(pc / 4)];
             const bool ok = (bank.cycle != now) | (bank.pc == pc);

@@ -263,12 +263,15 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
     if (tm.running == 0) return;
 
     // Granted loads/stores take their L1 bank in rotating order.
-    for_each_rotated_part(tm.words, tm.rotation, [&](uint32_t w, uint64_t part) {
-        for_each_bit(w, tm.mem_waiting_tps[w] & part, [&](uint32_t i) {
-            Tm::Tp& tp = tm.tps[i];
+    for_each_rotated_part(tm.words, tm.rotation, [&](const RotatedPart& part) {
+        uint64_t accessed = 0;
+        for (uint64_t bits = part.of(tm.mem_waiting_tps[part.w]); bits != 0; bits &= bits - 1) {
+            const auto bit = static_cast<uint32_t>(std::countr_zero(bits));
+            const Tm::Tp& tp = tm.tps[part.index(bit)];
             if (tp.mem_at <= now && accepted(tm.l1.access(now, tp.mem_request)))
-                clear_bit(tm.mem_waiting_tps, i);
-        });
+                accessed |= uint64_t{1} << bit;
+        }
+        tm.mem_waiting_tps[part.w] &= ~part.back(accessed);
     });
 
     // Every awake TP: fetch if it holds no instruction, check the scoreboard, request a unit.
@@ -279,23 +282,30 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
     Tm::Tp* const tps = tm.tps.data();
     const uint32_t first_thread = tm.id * n;
     auto& counters = tm.counters;
-    for_each_rotated_part(tm.words, tm.rotation, [&](uint32_t w, uint64_t part) {
-        const uint64_t fetching = tm.awake_tps[w] & part & ~tm.pending_tps[w];
+    // Forced inline (GCC keeps a lambda called from two sites out of line): out of line, its
+    // captures are reloaded through memory at every use.
+    const auto fetch_part = [&](const RotatedPart& part) __attribute__((always_inline)) {
+        const uint32_t w = part.w;
+        const uint64_t fetching = part.of(tm.awake_tps[w] & ~tm.pending_tps[w]);
         const uint64_t fetched = tm.icache.fetch(
-            now, w << 6, fetching, [&](uint32_t i) { return source.next_pc(first_thread + i); });
+            now, fetching, [&](uint32_t bit) { return part.index(bit); },
+            [&](uint32_t i) { return source.next_pc(first_thread + i); });
         counters.stalls[size_t(Stall::FetchConflict)] += count_bits(fetching & ~fetched);
         uint64_t needs_port = 0;
-        for_each_bit(w, fetched, [&](uint32_t i) {
+        for (uint64_t bits = fetched; bits != 0; bits &= bits - 1) {
+            const auto bit = static_cast<uint32_t>(std::countr_zero(bits));
+            const uint32_t i = part.index(bit);
             Tm::Tp& tp = tps[i];
             source.step(first_thread + i, tp.pending);
             tp.pending_pool = pool_of_[size_t(tp.pending.insn->fu)];
             const bool global_access =  // bitwise &: no branch on an unpredictable outcome
                 (tp.pending_pool == Pool::LoadStore) & !is_local(tp.pending.mem_address);
-            needs_port |= uint64_t{global_access} << (i & 63);
-        });
-        tm.needs_port_tps[w] |= needs_port;
-        tm.pending_tps[w] |= fetched;
-    });
+            needs_port |= uint64_t{global_access} << bit;
+        }
+        tm.needs_port_tps[w] |= part.back(needs_port);
+        tm.pending_tps[w] |= part.back(fetched);
+    };
+    for_each_rotated_part(tm.words, tm.rotation, fetch_part);
 
     uint32_t requested_pools = 0;  // bit per pool with a request this cycle
     std::array<uint32_t, kPools> requests{};  // requests per pool this cycle

@@ -126,7 +126,7 @@ TEST_CASE("I-cache banks: one address per bank per cycle, shared addresses broad
           "[icache]") {
     ICacheBanks icache(ICacheConfig{16, 4}, 32);
     auto fetch = [&](uint64_t now, uint32_t tp, uint32_t pc) {
-        return icache.fetch(now, tp, 1, [&](uint32_t thread) { return thread == tp ? pc : 0; }) == 1;
+        return icache.fetch(now, 1, [&](uint32_t) { return tp; }, [&](uint32_t) { return pc; }) == 1;
     };
     CHECK(fetch(0, 0, 0x1000));
     CHECK(fetch(0, 1, 0x1000));        // same address: broadcast
@@ -142,8 +142,9 @@ TEST_CASE("I-cache banks: a set of threads fetches lowest bit first", "[icache]"
     ICacheBanks icache(ICacheConfig{16, 4}, 32);
     // Threads 4..7 all want bank 0; 4 and 6 the same address: 4 wins, 6 shares it.
     const uint32_t pcs[] = {0x1000, 0x1010, 0x1000, 0x1020};
-    const uint64_t granted =
-        icache.fetch(0, 4, 0b1111, [&](uint32_t thread) { return pcs[thread - 4]; });
+    const uint64_t granted = icache.fetch(
+        0, 0b1111, [](uint32_t bit) { return 4 + bit; },
+        [&](uint32_t thread) { return pcs[thread - 4]; });
     CHECK(granted == 0b0101);
     CHECK(icache.counters().fetches == 2);
     CHECK(icache.counters().conflicts == 2);
