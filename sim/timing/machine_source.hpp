@@ -51,7 +51,7 @@ public:
     }
 
 private:
-    static constexpr uint32_t kAhead = 64;  // records buffered per thread
+    static constexpr uint32_t kAhead = 128;  // records buffered per thread
     struct Ahead {
         std::array<StepInfo, kAhead> records;
         uint32_t next = 0, size = 0;
