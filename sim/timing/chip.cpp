@@ -331,7 +331,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             for (uint8_t r : regs) operands_at = std::max(operands_at, tp.reg_ready[r]);
             Pool blocking = Pool::IntAlu;  // producer of the first operand that is ready last
             for (uint8_t r : regs)
-                if (r != isa::kNumRegs && tp.reg_ready[r] == operands_at) {
+                if (r != isa::kNoReg && tp.reg_ready[r] == operands_at) {
                     blocking = tp.reg_producer[r];
                     break;
                 }
