@@ -376,7 +376,10 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
         progress_ += requests[p] - denied;
     }
     for (uint32_t w = 0; w < tm.words; ++w) {
-        for_each_bit(w, std::exchange(tm.issuing_tps[w], 0), [&](uint32_t i) {
+        const uint64_t issuing = std::exchange(tm.issuing_tps[w], 0);
+        tm.pending_tps[w] &= ~issuing;
+        tm.needs_port_tps[w] &= ~issuing;
+        for_each_bit(w, issuing, [&](uint32_t i) {
             Tm::Tp& tp = tps[i];
             const StepInfo& s = tp.pending;
             const isa::Decoded& d = *s.insn;
@@ -402,8 +405,6 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
                 tp.reg_ready[d.rd] = result_at;
                 tp.reg_producer[d.rd] = pool;
             }
-            clear_bit(tm.pending_tps, i);
-            clear_bit(tm.needs_port_tps, i);
             if (s.exited) {
                 clear_bit(tm.awake_tps, i);
                 --tm.running;
