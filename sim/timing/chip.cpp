@@ -313,15 +313,21 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
         const uint64_t visiting = tm.awake_tps[w];
         counters.active_tp_cycles += count_bits(visiting);
 
-        // Scoreboard: ready when every operand (and rd: no write-after-write reorder) is.
+        // Scoreboard: ready when every operand (and rd: no write-after-write reorder) is. A
+        // ready TP asks its pool for a unit, unless it is a global load/store and the previous
+        // one has not reached its L1 bank yet (one L1 access at a time per TP).
         const uint64_t holding = visiting & tm.pending_tps[w];
+        const uint64_t port_taken = tm.needs_port_tps[w] & tm.mem_waiting_tps[w];
         uint64_t ready = 0;
+        std::array<uint64_t, kPools> asking{};  // this word's requesters, by pool
         for_each_bit(w, holding, [&](uint32_t i) {
             const isa::Decoded& d = *tps[i].pending.insn;
             const uint64_t* at = tps[i].reg_ready.data();
             const uint64_t operands_at =
                 std::max(std::max(at[d.rs1], at[d.rs2]), std::max(at[d.rs3], at[d.rd]));
-            ready |= uint64_t{operands_at <= now} << (i & 63);
+            const uint64_t bit = uint64_t{operands_at <= now} << (i & 63);
+            ready |= bit;
+            asking[size_t(tps[i].pending_pool)] |= bit & ~port_taken;  // no branch either way
         });
         for_each_bit(w, holding & ~ready, [&](uint32_t i) {
             Tm::Tp& tp = tps[i];
@@ -350,14 +356,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             }
         });
 
-        // One L1 access at a time per TP: a global load/store waits while the previous one
-        // has not reached its L1 bank.
-        const uint64_t port_busy = ready & tm.needs_port_tps[w] & tm.mem_waiting_tps[w];
-        counters.stalls[size_t(Stall::MemoryPort)] += count_bits(port_busy);
-        std::array<uint64_t, kPools> asking{};  // this word's requesters, by pool
-        for_each_bit(w, ready & ~port_busy, [&](uint32_t i) {
-            asking[size_t(tps[i].pending_pool)] |= uint64_t{1} << (i & 63);
-        });
+        counters.stalls[size_t(Stall::MemoryPort)] += count_bits(ready & port_taken);
         for (size_t p = 0; p < kPools; ++p)
             if (asking[p] != 0) {
                 tm.pools[p].request(w, asking[p]);
