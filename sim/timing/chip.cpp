@@ -308,7 +308,6 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
     for_each_rotated_part(tm.words, tm.rotation, fetch_part);
 
     uint32_t requested_pools = 0;  // bit per pool with a request this cycle
-    std::array<uint32_t, kPools> requests{};  // requests per pool this cycle
     for (uint32_t w = 0; w < tm.words; ++w) {
         const uint64_t visiting = tm.awake_tps[w];
         counters.active_tp_cycles += count_bits(visiting);
@@ -360,7 +359,6 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
         for (size_t p = 0; p < kPools; ++p)
             if (asking[p] != 0) {
                 tm.pools[p].request(w, asking[p]);
-                requests[p] += count_bits(asking[p]);
                 requested_pools |= 1u << p;
             }
     }
@@ -369,10 +367,10 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
     // winners of every pool issue in one pass.
     for (; requested_pools != 0; requested_pools &= requested_pools - 1) {
         const auto p = static_cast<size_t>(std::countr_zero(requested_pools));
-        const uint32_t denied = tm.pools[p].arbitrate(now, tm.issuing_tps.data());
-        counters.stalls[size_t(Stall::FuBusy)] += denied;
-        counters.instructions += requests[p] - denied;
-        progress_ += requests[p] - denied;
+        const FuPool::Grants grants = tm.pools[p].arbitrate(now, tm.issuing_tps.data());
+        counters.stalls[size_t(Stall::FuBusy)] += grants.denied;
+        counters.instructions += grants.granted;
+        progress_ += grants.granted;
     }
     for (uint32_t w = 0; w < tm.words; ++w) {
         const uint64_t issuing = std::exchange(tm.issuing_tps[w], 0);

@@ -33,6 +33,12 @@ public:
 
     FuPool(const FuConfig& config, uint32_t num_requesters);
 
+    /// What one cycle's arbitration did.
+    struct Grants {
+        uint32_t granted = 0;
+        uint32_t denied = 0;
+    };
+
     /// Requesters 64 * word + b, for each set bit b of `ids`, want a unit this cycle. Call
     /// before arbitrate(), at most once per requester.
     void request(uint32_t word, uint64_t ids) {
@@ -43,9 +49,9 @@ public:
     /// Grants free units to this cycle's requests in rotating-priority order: the winners'
     /// bits are OR-ed into `winners` (a word per 64 requesters, as in request()); their results
     /// can be read at now + latency. The others are denied and should request again next
-    /// cycle. Returns how many were denied.
-    uint32_t arbitrate(uint64_t now, uint64_t* winners) {
-        if (requests_ == 0) return 0;
+    /// cycle.
+    Grants arbitrate(uint64_t now, uint64_t* winners) {
+        if (requests_ == 0) return {};
         // No unit frees up within a cycle, so the winners are the first `granted` requesters
         // in rotating-priority order.
         const uint32_t granted = std::min(requests_, free_units(now));
@@ -95,7 +101,7 @@ public:
         counters_.denied += denied;
         started_ += granted;
         if (granted != 0) next_priority_ = last + 1 == num_requesters_ ? 0 : last + 1;
-        return denied;
+        return {granted, denied};
     }
 
     const Counters& counters() const { return counters_; }
