@@ -141,7 +141,8 @@ template <bool kRecord> class ThreadEnv {
     try {
         for (;;) {
             pc = h.pc;
-            const uint32_t index = std::rotr(pc - text_base, 2); // range and alignment, as in run_quantum
+            // One compare checks range and alignment, as in run_quantum.
+            const uint32_t index = std::rotr(pc - text_base, 2);
             if (index >= text_words) [[unlikely]]
                 fetch_fault(id, pc);
             const isa::Decoded& d = decoded[index];
@@ -152,7 +153,8 @@ template <bool kRecord> class ThreadEnv {
             isa::execute(d, h, env);
             record.taken = !record.exited && h.pc != pc + 4;
             // An exited thread's pc is parked outside the code, so it is not private either.
-            if (++n == capacity || !is_private(h, std::rotr(h.pc - text_base, 2), text_words)) break;
+            if (++n == capacity || !is_private(h, std::rotr(h.pc - text_base, 2), text_words))
+                break;
         }
     } catch (const GuestFault& f) {
         count();

@@ -126,7 +126,8 @@ TEST_CASE("I-cache banks: one address per bank per cycle, shared addresses broad
           "[icache]") {
     ICacheBanks icache(ICacheConfig{16, 4}, 32);
     auto fetch = [&](uint64_t now, uint32_t tp, uint32_t pc) {
-        return icache.fetch(now, 1, [&](uint32_t) { return tp; }, [&](uint32_t) { return pc; }) == 1;
+        const auto tp_of = [&](uint32_t) { return tp; };
+        return icache.fetch(now, 1, tp_of, [&](uint32_t) { return pc; }) == 1;
     };
     CHECK(fetch(0, 0, 0x1000));
     CHECK(fetch(0, 1, 0x1000));        // same address: broadcast
