@@ -185,7 +185,11 @@ uint64_t Chip::run_with(Source& source, uint64_t max_cycles, const ProgressHook&
                 "timing: the chip did not finish within {} cycles; raise the cycle limit",
                 max_cycles));
         tick_shared(now);
-        for (auto& tm : tms_) tick_tm(*tm, now, source);
+        // TMs of up to 64 TPs (one word per bit set) take a loop without word loops.
+        if (config_.chip.tps_per_tm <= 64)
+            for (auto& tm : tms_) tick_tm<Source, 1>(*tm, now, source);
+        else
+            for (auto& tm : tms_) tick_tm<Source, 0>(*tm, now, source);
         cycles_ = now + 1;
         if (on_progress && cycles_ % kProgressInterval == 0) on_progress(cycles_);
         if (progress_ != last_progress) {
@@ -251,8 +255,9 @@ void Chip::tick_shared(uint64_t now) {
     }
 }
 
-template <class Source>
+template <class Source, uint32_t kWords>
 void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
+    const uint32_t words = kWords != 0 ? kWords : tm.words;  // kWords: known at compile time
     const uint32_t n = static_cast<uint32_t>(tm.tps.size());
     MemReply reply;
     while (tm.l1.pop_reply(now, reply)) {
@@ -263,7 +268,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
     if (tm.running == 0) return;
 
     // Granted loads/stores take their L1 bank in rotating order.
-    for_each_rotated_part(tm.words, tm.rotation, [&](const RotatedPart& part) {
+    for_each_rotated_part(words, tm.rotation, [&](const RotatedPart& part) {
         uint64_t accessed = 0;
         for (uint64_t bits = part.of(tm.mem_waiting_tps[part.w]); bits != 0; bits &= bits - 1) {
             const auto bit = static_cast<uint32_t>(std::countr_zero(bits));
@@ -305,10 +310,10 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
         tm.needs_port_tps[w] |= part.back(needs_port);
         tm.pending_tps[w] |= part.back(fetched);
     };
-    for_each_rotated_part(tm.words, tm.rotation, fetch_part);
+    for_each_rotated_part(words, tm.rotation, fetch_part);
 
     uint32_t requested_pools = 0;  // bit per pool with a request this cycle
-    for (uint32_t w = 0; w < tm.words; ++w) {
+    for (uint32_t w = 0; w < words; ++w) {
         const uint64_t visiting = tm.awake_tps[w];
         counters.active_tp_cycles += count_bits(visiting);
 
@@ -372,7 +377,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
         counters.instructions += grants.granted;
         progress_ += grants.granted;
     }
-    for (uint32_t w = 0; w < tm.words; ++w) {
+    for (uint32_t w = 0; w < words; ++w) {
         const uint64_t issuing = std::exchange(tm.issuing_tps[w], 0);
         tm.pending_tps[w] &= ~issuing;
         tm.needs_port_tps[w] &= ~issuing;

@@ -77,7 +77,7 @@ private:
     template <class Source>
     uint64_t run_with(Source& source, uint64_t max_cycles, const ProgressHook& on_progress);
     void tick_shared(uint64_t now);
-    template <class Source>
+    template <class Source, uint32_t kWords>  // kWords: words per TP bit set, 0 = any
     void tick_tm(Tm& tm, uint64_t now, Source& source);
 
     ChipConfig config_;
