@@ -57,43 +57,28 @@ public:
         const uint32_t granted = std::min(requests_, free_units(now));
         const uint32_t denied = requests_ - granted;
         uint32_t last = 0;  // the last winner in priority order
-        if (requested_.size() == 1) {
-            // Up to 64 requesters: the word rotated right by the priority pointer holds the
-            // requests in priority order (no bit at or above num_requesters_ is ever set).
-            const int start = static_cast<int>(next_priority_);
-            uint64_t order = std::rotr(requested_[0], start);
-            requested_[0] = 0;
-            if (denied != 0) {
+        uint32_t left = granted;
+        // Rotated walk (bits.hpp): for up to 64 requesters one part, the request word rotated
+        // by the priority pointer, so the winners are its lowest `granted` bits.
+        const auto take = [&](const RotatedPart& part) __attribute__((always_inline)) {
+            uint64_t won = part.of(requested_[part.w]);
+            requested_[part.w] &= ~part.mask;  // taken: this part's requests are decided
+            if (denied != 0) {  // else every request wins
                 uint64_t first = 0;
-                for (uint32_t left = granted; left != 0; --left, order &= order - 1)
+                for (uint64_t order = won; order != 0 && left != 0; order &= order - 1, --left)
                     first |= order & -order;
-                order = first;
+                won = first;
             }
-            if (order != 0) last = static_cast<uint32_t>(63 - std::countl_zero(order) + start) & 63;
-            winners[0] |= std::rotl(order, start);
-        } else {
-            // The words walked from the pointer's with wrap-around, the first one twice: its
-            // bits from the pointer up first, the ones below it last.
-            const uint32_t words = static_cast<uint32_t>(requested_.size());
-            const uint32_t first_word = next_priority_ >> 6;
-            const uint64_t below_start = (uint64_t{1} << (next_priority_ & 63)) - 1;
-            uint32_t left = granted;
-            for (uint32_t k = 0, w = first_word; left != 0; ++k, w = w + 1 == words ? 0 : w + 1) {
-                uint64_t bits = requested_[w];
-                if (k == 0) bits &= ~below_start;
-                else if (k == words) bits &= below_start;
-                for (; bits != 0 && left != 0; bits &= bits - 1, --left) {
-                    winners[w] |= bits & -bits;
-                    last = (w << 6) + static_cast<uint32_t>(std::countr_zero(bits));
-                }
-            }
-            for (uint64_t& word : requested_) word = 0;
-        }
+            if (won == 0) return;
+            last = part.index(static_cast<uint32_t>(63 - std::countl_zero(won)));
+            winners[part.w] |= part.back(won);
+        };
+        for_each_rotated_part(static_cast<uint32_t>(requested_.size()), next_priority_, take);
         if (!config_.pipelined) {
             // Winners take the first free units, each busy until its result is out.
-            uint32_t left = granted;
+            uint32_t unstarted = granted;
             for (uint64_t& free_at : unit_free_at_)
-                if (left != 0 && free_at <= now) free_at = now + config_.latency, --left;
+                if (unstarted != 0 && free_at <= now) free_at = now + config_.latency, --unstarted;
         }
         requests_ = 0;
         counters_.issued += granted;
