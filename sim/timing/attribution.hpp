@@ -1,0 +1,74 @@
+// Where the cycles and the bytes go: what the chip counts beyond its totals — traffic by memory
+// region, costs by instruction address (the source-line profile) and costs by work item (the
+// per-pixel heat map). docs/statistics.md defines every figure.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace tpsim::timing {
+
+/// Why a TP did not issue in a cycle (exactly one cause per TP-cycle).
+enum class Stall : uint8_t {
+    FetchConflict,  ///< lost the I-cache bank to another thread
+    Branch,         ///< bubble after a branch (tp.branch_*_penalty)
+    FuBusy,         ///< operands ready but every unit of the pool was taken
+    MemoryPort,     ///< a previous load/store still waits for an L1 bank or MSHR
+    Operand,        ///< an operand is not ready; attributed to its producing pool
+    Count
+};
+constexpr size_t kStallCauses = static_cast<size_t>(Stall::Count);
+
+/// A named range [begin, end) of guest byte addresses: a section of the memory image or a
+/// segment of the kernel ELF. The chip tags each global load/store with its region once, when
+/// it issues, and every level counts by that tag.
+struct Region {
+    std::string name;  ///< a statistics-name segment, e.g. "bvh_nodes"
+    uint32_t begin = 0, end = 0;
+};
+
+/// What the chip is told about the program and the memory it runs over (not configuration:
+/// it follows from the scene and the kernel).
+struct ChipLayout {
+    /// Non-overlapping, any order. Global accesses outside all of them count as "other".
+    std::vector<Region> regions;
+    /// The kernel's text [text_base, text_base + 4 * text_words): one profile entry per word.
+    uint32_t text_base = 0, text_words = 0;
+    /// Work items handed out by atomicinc on global register 0 (the pixel counter of the
+    /// kernels): 0..work_items-1 are charged per item, others to WorkItemCosts::unassigned.
+    uint32_t work_items = 0;
+    /// Collect the per-instruction profile (PcProfile); off: profile() is empty.
+    bool profile = false;
+};
+
+/// One instruction address's costs.
+struct PcCounters {
+    uint64_t executions = 0;                      ///< times issued
+    std::array<uint64_t, kStallCauses> stalls{};  ///< TP-cycles its thread stalled on it
+    uint64_t l1_misses = 0;                       ///< its loads that missed in the L1
+    uint64_t dram_bytes = 0;                      ///< DRAM bytes moved for its misses and stores
+};
+
+/// Costs by instruction address: words[(pc - text_base) / 4].
+struct PcProfile {
+    uint32_t text_base = 0;
+    std::vector<PcCounters> words;
+};
+
+/// One work item's costs: a thread's cycles, instructions and DRAM bytes from the atomicinc(0)
+/// that returned the item to the thread's next atomicinc(0) (or its exit).
+struct WorkItemCounters {
+    uint64_t cycles = 0;
+    uint64_t instructions = 0;
+    uint64_t dram_bytes = 0;
+};
+
+struct WorkItemCosts {
+    std::vector<WorkItemCounters> items;  ///< ChipLayout::work_items entries
+    /// Before a thread's first atomicinc(0), and while it holds a value >= work_items (the
+    /// fetch past the end that tells it to stop).
+    WorkItemCounters unassigned;
+};
+
+}  // namespace tpsim::timing
