@@ -3,6 +3,7 @@
 #pragma once
 #include <charconv>
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <string>
 
@@ -27,7 +28,16 @@ inline const CLI::Validator kPositiveCount(
     },
     "COUNT");
 
+/// Throws tpsim::Error unless a file can be created at `path` (its directory exists); `what`
+/// names the file in the message ("the report").
+void check_output_path(const std::filesystem::path& path, const std::string& what);
+/// Writes `text` to `path`, throwing tpsim::Error naming both on failure.
+void write_output(const std::filesystem::path& path, const std::string& text,
+                  const std::string& what);
+
 Command add_exec_command(CLI::App& app);
 Command add_render_command(CLI::App& app);
+Command add_compare_command(CLI::App& app);
+Command add_report_command(CLI::App& app);
 
 }  // namespace tpsim::cli

@@ -11,8 +11,9 @@ int main(int argc, char** argv) {
     // At most one; none is reported below, so that a misspelt subcommand is named as such
     // instead of "A subcommand is required".
     app.require_subcommand(0, 1);
-    const tpsim::cli::Command commands[] = {tpsim::cli::add_render_command(app),
-                                            tpsim::cli::add_exec_command(app)};
+    const tpsim::cli::Command commands[] = {
+        tpsim::cli::add_render_command(app), tpsim::cli::add_exec_command(app),
+        tpsim::cli::add_compare_command(app), tpsim::cli::add_report_command(app)};
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -20,7 +21,8 @@ int main(int argc, char** argv) {
         return app.exit(e) == 0 ? 0 : 2;
     }
     if (app.get_subcommands().empty()) {
-        fmt::print(stderr, "tpsim: give a subcommand: render or exec (tpsim --help)\n");
+        fmt::print(stderr,
+                   "tpsim: give a subcommand: render, exec, compare or report (tpsim --help)\n");
         return 2;
     }
     try {

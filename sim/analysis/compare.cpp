@@ -1,0 +1,517 @@
+#include "sim/analysis/compare.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <ostream>
+#include <set>
+
+#include <fmt/format.h>
+
+namespace tpsim::analysis {
+namespace {
+
+constexpr const char* kAbsent = "(absent)";
+
+/// Splits "region/bvh_nodes/l1/reads" into its '/'-separated segments.
+std::vector<std::string> segments(std::string_view name) {
+    std::vector<std::string> parts;
+    size_t start = 0;
+    for (size_t slash; (slash = name.find('/', start)) != std::string_view::npos; start = slash + 1)
+        parts.emplace_back(name.substr(start, slash - start));
+    parts.emplace_back(name.substr(start));
+    return parts;
+}
+
+/// Appends `item` unless it is there already (keeps first-seen order, which is file order).
+void add_unique(std::vector<std::string>& list, const std::string& item) {
+    if (std::find(list.begin(), list.end(), item) == list.end()) list.push_back(item);
+}
+
+Row stat_row(const std::vector<StatsFile>& runs, const std::string& key, Better better) {
+    Row row{key, "", better, {}};
+    for (const StatsFile& run : runs) {
+        row.values.push_back(run.stat(key));
+        if (row.unit.empty()) row.unit = run.unit(key);
+    }
+    return row;
+}
+
+/// A figure computed from others in each run (absent where a part is absent or divides by 0).
+template <class Derive>
+Row derived_row(const std::vector<StatsFile>& runs, std::string key, std::string unit,
+                Better better, Derive derive) {
+    Row row{std::move(key), std::move(unit), better, {}};
+    for (const StatsFile& run : runs)
+        row.values.push_back(derive(run));
+    return row;
+}
+
+std::optional<double> quotient(std::optional<double> numerator, std::optional<double> denominator) {
+    if (!numerator || !denominator || *denominator == 0) return std::nullopt;
+    return *numerator / *denominator;
+}
+
+bool has_any(const Row& row) {
+    return std::any_of(row.values.begin(), row.values.end(), [](auto v) { return v.has_value(); });
+}
+
+bool has_nonzero(const Row& row) {
+    return std::any_of(row.values.begin(), row.values.end(), [](auto v) { return v && *v != 0; });
+}
+
+/// Keys `prefix<one segment>suffix` present in any run, in file order of the first run that
+/// has each.
+std::vector<std::string> keys_like(const std::vector<StatsFile>& runs, std::string_view prefix,
+                                   std::string_view suffix) {
+    std::vector<std::string> keys;
+    for (const StatsFile& run : runs)
+        for (const auto& [name, value] : run.stats) {
+            if (!name.starts_with(prefix) || !name.ends_with(suffix) ||
+                name.size() <= prefix.size() + suffix.size())
+                continue;
+            const std::string_view middle(name.data() + prefix.size(),
+                                          name.size() - prefix.size() - suffix.size());
+            if (middle.find('/') == std::string_view::npos) add_unique(keys, name);
+        }
+    return keys;
+}
+
+Section summary_section(const std::vector<StatsFile>& runs) {
+    Section s{"summary", {}};
+    const std::pair<const char*, Better> keys[] = {
+        {"chip/cycles", Better::lower},           {"chip/frame_seconds", Better::lower},
+        {"chip/rays_per_second", Better::higher}, {"instructions/total", Better::lower},
+        {"chip/issue_rate", Better::higher},      {"chip/l1/hit_rate", Better::higher},
+        {"chip/l2/hit_rate", Better::higher},     {"dram/bytes_read", Better::lower},
+        {"dram/bytes_written", Better::lower},    {"chip/dram/bandwidth_gbps", Better::neutral},
+        {"rays/total", Better::neutral}};
+    for (const auto& [key, better] : keys)
+        s.rows.push_back(stat_row(runs, key, better));
+    return s;
+}
+
+Section keyed_section(const std::vector<StatsFile>& runs, std::string title,
+                      std::string_view prefix, std::string_view suffix, Better better) {
+    Section s{std::move(title), {}};
+    for (const std::string& key : keys_like(runs, prefix, suffix))
+        s.rows.push_back(stat_row(runs, key, better));
+    return s;
+}
+
+/// Region x level traffic: the regions each run lists, then any others its keys name
+/// (local_store, instruction_fetch); for each level the figures present; all-zero rows left out.
+Section traffic_section(const std::vector<StatsFile>& runs) {
+    std::vector<std::string> regions;
+    for (const StatsFile& run : runs)
+        for (const std::string& region : run.regions)
+            add_unique(regions, region);
+    // levels[region] in first-seen order
+    std::vector<std::pair<std::string, std::vector<std::string>>> levels;
+    for (const std::string& region : regions)
+        levels.push_back({region, {}});
+    for (const StatsFile& run : runs)
+        for (const auto& [name, value] : run.stats) {
+            const std::vector<std::string> parts = segments(name);
+            if (parts.size() != 4 || parts[0] != "region") continue;
+            auto found = std::find_if(levels.begin(), levels.end(),
+                                      [&](const auto& l) { return l.first == parts[1]; });
+            if (found == levels.end()) found = levels.insert(levels.end(), {parts[1], {}});
+            add_unique(found->second, parts[2]);
+        }
+    Section s{"traffic by region and level", {}};
+    const std::pair<const char*, Better> leaves[] = {{"payload_bytes", Better::lower},
+                                                     {"moved_bytes", Better::lower},
+                                                     {"reads", Better::neutral},
+                                                     {"misses", Better::lower}};
+    for (const auto& [region, region_levels] : levels)
+        for (const std::string& level : region_levels) {
+            const std::string prefix = "region/" + region + "/" + level + "/";
+            for (const auto& [leaf, better] : leaves) {
+                Row row = stat_row(runs, prefix + leaf, better);
+                if (has_nonzero(row)) s.rows.push_back(std::move(row));
+            }
+            Row hit_rate = derived_row(
+                runs, prefix + "hit_rate", "ratio", Better::higher, [&](const StatsFile& run) {
+                    return quotient(run.stat(prefix + "hits"), run.stat(prefix + "reads"));
+                });
+            if (has_any(hit_rate)) s.rows.push_back(std::move(hit_rate));
+        }
+    return s;
+}
+
+Section per_ray_section(const std::vector<StatsFile>& runs) {
+    Section s{"per ray", {}};
+    s.rows.push_back(derived_row(
+        runs, "per_ray/instructions", "instructions", Better::lower, [](const StatsFile& run) {
+            return quotient(run.stat("instructions/total"), run.stat("rays/total"));
+        }));
+    s.rows.push_back(derived_row(runs, "per_ray/dram_bytes", "B", Better::lower,
+                                 [](const StatsFile& run) -> std::optional<double> {
+                                     const auto read = run.stat("dram/bytes_read");
+                                     const auto written = run.stat("dram/bytes_written");
+                                     if (!read || !written) return std::nullopt;
+                                     return quotient(*read + *written, run.stat("rays/total"));
+                                 }));
+    s.rows.push_back(stat_row(runs, "traversal/nodes_per_ray", Better::lower));
+    s.rows.push_back(stat_row(runs, "traversal/triangles_per_ray", Better::lower));
+    return s;
+}
+
+std::vector<SetupDifference> setup_differences(const std::vector<StatsFile>& runs) {
+    std::vector<SetupDifference> differences;
+    const auto add_if_different = [&](std::string field, std::vector<std::string> values) {
+        if (std::adjacent_find(values.begin(), values.end(), std::not_equal_to<>()) != values.end())
+            differences.push_back({std::move(field), std::move(values)});
+    };
+    const auto run_field = [](const StatsFile& run, std::string_view key) {
+        const std::string text = run.run_text(key);
+        return text.empty() ? std::string(kAbsent) : text;
+    };
+    for (const char* field : {"scene", "kernel", "engine", "bvh_builder", "max_leaf"}) {
+        std::vector<std::string> values;
+        for (const StatsFile& run : runs)
+            values.push_back(run_field(run, field));
+        add_if_different(field, values);
+    }
+    std::vector<std::string> sizes;
+    for (const StatsFile& run : runs)
+        sizes.push_back(run_field(run, "width") + "x" + run_field(run, "height"));
+    add_if_different("image size", sizes);
+    for (const char* field : {"samples_per_pixel", "threads"}) {
+        std::vector<std::string> values;
+        for (const StatsFile& run : runs)
+            values.push_back(run_field(run, field));
+        add_if_different(field, values);
+    }
+    std::vector<std::string> keys;
+    for (const StatsFile& run : runs)
+        for (const auto& [key, value] : run.config)
+            add_unique(keys, key);
+    for (const std::string& key : keys) {
+        std::vector<std::string> values;
+        for (const StatsFile& run : runs) {
+            const auto found = std::find_if(run.config.begin(), run.config.end(),
+                                            [&](const auto& entry) { return entry.first == key; });
+            values.push_back(found == run.config.end()   ? std::string(kAbsent)
+                             : found->second.is_string() ? found->second.get<std::string>()
+                                                         : found->second.dump());
+        }
+        add_if_different("config " + key, values);
+    }
+    return differences;
+}
+
+std::optional<ImageDifference> image_difference(const StatsFile& first, const StatsFile& other) {
+    const auto a = first.run_file("image");
+    const auto b = other.run_file("image");
+    if (!a && !b) return std::nullopt;
+    if (!a || !b) {
+        ImageDifference d;
+        d.note = fmt::format("{} names no image", (!a ? first : other).path.string());
+        return d;
+    }
+    return compare_images(*a, *b);
+}
+
+// ---- printing ----
+
+std::string format_ratio(std::optional<double> ratio) {
+    return ratio ? fmt::format("{:.3f}x", *ratio) : "-";
+}
+
+std::string format_cell(std::optional<double> value) {
+    return value ? format_number(*value) : "-";
+}
+
+std::string run_letter(size_t run) {
+    return run < 26 ? std::string(1, char('A' + run)) : fmt::format("R{}", run + 1);
+}
+
+std::string image_line(const ImageDifference& d) {
+    if (!d.compared()) return d.note;
+    if (d.differing_pixels == 0) return fmt::format("identical ({} pixels)", d.pixels);
+    return fmt::format("RMSE {:.6f}, PSNR {:.2f} dB, {} of {} pixels differ ({:.2f} %)", d.rmse,
+                       d.psnr, d.differing_pixels, d.pixels, 100 * d.differing_share());
+}
+
+/// ANSI colour of a notable ratio: green better, red worse, yellow when neither is better.
+const char* colour_of(const Row& row, size_t run) {
+    if (!row.differs_notably(run)) return nullptr;
+    if (row.better == Better::neutral) return "\033[33m";
+    const bool up = *row.ratio(run) > 1;
+    return up == (row.better == Better::higher) ? "\033[32m" : "\033[31m";
+}
+
+void write_text(const Comparison& c, std::ostream& out, bool colour) {
+    const size_t n = c.runs.size();
+    for (size_t i = 0; i < n; ++i)
+        out << fmt::format("{:<10}{}  {}\n", i == 0 ? "runs" : "", run_letter(i), c.runs[i]);
+    if (c.differences.empty())
+        out << fmt::format("{:<10}none in run fields or configuration\n", "differs");
+    for (size_t i = 0; i < c.differences.size(); ++i) {
+        const SetupDifference& d = c.differences[i];
+        std::string values;
+        for (size_t r = 0; r < n; ++r)
+            values += (r ? " | " : "") + d.values[r];
+        out << fmt::format("{:<10}{:<32} {}\n", i == 0 ? "differs" : "", d.field, values);
+    }
+    for (size_t i = 0; i < c.images.size(); ++i)
+        if (c.images[i])
+            out << fmt::format("{:<10}{} vs A: {}\n", "image", run_letter(i + 1),
+                               image_line(*c.images[i]));
+    if (has_any(c.host)) {
+        std::string values;
+        for (size_t r = 0; r < n; ++r)
+            values += fmt::format("  {} {}", run_letter(r), format_cell(c.host.values[r]));
+        out << fmt::format("{:<10}host wall time, not a result: {} ({}){}\n", "host", c.host.key,
+                           c.host.unit, values);
+    }
+    for (const Section& section : c.sections) {
+        if (section.rows.empty()) continue;
+        size_t key_width = section.title.size();
+        for (const Row& row : section.rows)
+            key_width = std::max(key_width, row.key.size());
+        out << fmt::format("\n{:<{}}  {:<12}", section.title, key_width, "unit");
+        for (size_t r = 0; r < n; ++r) {
+            out << fmt::format(" {:>14}", run_letter(r));
+            if (r) out << fmt::format(" {:>8}", run_letter(r) + "/A");
+        }
+        out << "\n";
+        for (const Row& row : section.rows) {
+            out << fmt::format("{:<{}}  {:<12}", row.key, key_width, row.unit);
+            for (size_t r = 0; r < n; ++r) {
+                out << fmt::format(" {:>14}", format_cell(row.values[r]));
+                if (r == 0) continue;
+                const std::string cell = fmt::format(" {:>8}", format_ratio(row.ratio(r)));
+                const char* ansi = colour ? colour_of(row, r) : nullptr;
+                out << (ansi ? ansi + cell + "\033[0m" : cell);
+            }
+            out << "\n";
+        }
+    }
+}
+
+void write_markdown(const Comparison& c, std::ostream& out) {
+    const size_t n = c.runs.size();
+    out << "| run | file |\n|---|---|\n";
+    for (size_t i = 0; i < n; ++i)
+        out << fmt::format("| {} | `{}` |\n", run_letter(i), c.runs[i]);
+    out << "\n";
+    if (!c.differences.empty()) {
+        out << "| differs |";
+        for (size_t r = 0; r < n; ++r)
+            out << " " << run_letter(r) << " |";
+        out << "\n|---|";
+        for (size_t r = 0; r < n; ++r)
+            out << "---|";
+        out << "\n";
+        for (const SetupDifference& d : c.differences) {
+            out << "| " << d.field << " |";
+            for (const std::string& v : d.values)
+                out << " " << v << " |";
+            out << "\n";
+        }
+        out << "\n";
+    }
+    for (size_t i = 0; i < c.images.size(); ++i)
+        if (c.images[i])
+            out << fmt::format("Image {} vs A: {}\n\n", run_letter(i + 1),
+                               image_line(*c.images[i]));
+    if (has_any(c.host)) {
+        out << fmt::format("Host wall time (not a result), `{}`:", c.host.key);
+        for (size_t r = 0; r < n; ++r)
+            out << fmt::format(" {} {} {}", run_letter(r), format_cell(c.host.values[r]),
+                               c.host.unit);
+        out << "\n\n";
+    }
+    for (const Section& section : c.sections) {
+        if (section.rows.empty()) continue;
+        out << "| " << section.title << " | unit |";
+        std::string rule = "|---|---|";
+        for (size_t r = 0; r < n; ++r) {
+            out << " " << run_letter(r) << " |";
+            rule += "---:|";
+            if (r) {
+                out << " " << run_letter(r) << "/A |";
+                rule += "---:|";
+            }
+        }
+        out << "\n" << rule << "\n";
+        for (const Row& row : section.rows) {
+            out << fmt::format("| `{}` | {} |", row.key, row.unit);
+            for (size_t r = 0; r < n; ++r) {
+                out << " " << format_cell(row.values[r]) << " |";
+                if (r) out << " " << format_ratio(row.ratio(r)) << " |";
+            }
+            out << "\n";
+        }
+        out << "\n";
+    }
+}
+
+std::string csv_field(const std::string& text) {
+    if (text.find_first_of(",\"\n") == std::string::npos) return text;
+    std::string quoted = "\"";
+    for (char ch : text)
+        quoted += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+    return quoted + "\"";
+}
+
+/// Exact figures for machines: integers in full, reals in the shortest round-trip form.
+std::string csv_number(std::optional<double> value) {
+    if (!value || !std::isfinite(*value)) return "";
+    return fmt::format("{}", *value);
+}
+
+void write_csv(const Comparison& c, std::ostream& out) {
+    const size_t n = c.runs.size();
+    out << "section,key,unit";
+    for (size_t r = 0; r < n; ++r) {
+        out << "," << csv_field(c.runs[r]);
+        if (r) out << "," << csv_field(c.runs[r] + " / " + c.runs[0]);
+    }
+    out << "\n";
+    for (const SetupDifference& d : c.differences) {
+        out << "setup," << csv_field(d.field) << ",";
+        for (size_t r = 0; r < n; ++r)
+            out << "," << csv_field(d.values[r]) << (r ? "," : "");
+        out << "\n";
+    }
+    for (const Section& section : c.sections)
+        for (const Row& row : section.rows) {
+            out << csv_field(section.title) << "," << csv_field(row.key) << ","
+                << csv_field(row.unit);
+            for (size_t r = 0; r < n; ++r) {
+                out << "," << csv_number(row.values[r]);
+                if (r) out << "," << csv_number(row.ratio(r));
+            }
+            out << "\n";
+        }
+    for (size_t i = 0; i < c.images.size(); ++i) {
+        if (!c.images[i]) continue;
+        const ImageDifference& d = *c.images[i];
+        const size_t r = i + 1;
+        const auto image_row = [&](const char* key, const std::string& value) {
+            out << "image," << key << ",";
+            for (size_t col = 0; col < n; ++col)
+                out << "," << (col == r ? value : "") << (col ? "," : "");
+            out << "\n";
+        };
+        if (!d.compared()) {
+            image_row("note", csv_field(d.note));
+            continue;
+        }
+        image_row("rmse", csv_number(d.rmse));
+        image_row("psnr_db", csv_number(d.psnr));
+        image_row("differing_pixels", csv_number(double(d.differing_pixels)));
+        image_row("pixels", csv_number(double(d.pixels)));
+    }
+}
+
+Json json_number(std::optional<double> value) {
+    return value && std::isfinite(*value) ? Json(*value) : Json();
+}
+
+void write_json(const Comparison& c, std::ostream& out) {
+    Json doc;
+    doc["format"] = "tpsim-compare";
+    doc["runs"] = c.runs;
+    doc["differences"] = Json::array();
+    for (const SetupDifference& d : c.differences)
+        doc["differences"].push_back({{"field", d.field}, {"values", d.values}});
+    doc["images"] = Json::array();
+    for (size_t i = 0; i < c.images.size(); ++i) {
+        if (!c.images[i]) continue;
+        const ImageDifference& d = *c.images[i];
+        Json image = {{"run", c.runs[i + 1]}, {"against", c.runs[0]}};
+        if (!d.compared()) {
+            image["note"] = d.note;
+        } else {
+            image["rmse"] = d.rmse;
+            image["psnr_db"] = json_number(d.psnr);  // null when identical (infinite)
+            image["differing_pixels"] = d.differing_pixels;
+            image["pixels"] = d.pixels;
+        }
+        doc["images"].push_back(image);
+    }
+    Json host = {{"key", c.host.key}, {"unit", c.host.unit}, {"values", Json::array()}};
+    for (const auto& v : c.host.values)
+        host["values"].push_back(json_number(v));
+    doc["host"] = host;
+    doc["sections"] = Json::array();
+    for (const Section& section : c.sections) {
+        Json rows = Json::array();
+        for (const Row& row : section.rows) {
+            Json values = Json::array(), ratios = Json::array();
+            for (size_t r = 0; r < row.values.size(); ++r) {
+                values.push_back(json_number(row.values[r]));
+                ratios.push_back(json_number(row.ratio(r)));
+            }
+            rows.push_back(
+                {{"key", row.key}, {"unit", row.unit}, {"values", values}, {"ratios", ratios}});
+        }
+        doc["sections"].push_back({{"title", section.title}, {"rows", rows}});
+    }
+    out << doc.dump(2) << "\n";
+}
+
+}  // namespace
+
+std::optional<double> Row::ratio(size_t run) const {
+    const auto& first = values.at(0);
+    const auto& value = values.at(run);
+    if (!first || !value) return std::nullopt;
+    if (*first == 0) return *value == 0 ? std::optional<double>(1.0) : std::nullopt;
+    return *value / *first;
+}
+
+bool Row::differs_notably(size_t run) const {
+    const auto r = ratio(run);
+    return r && (*r < 0.95 || *r > 1.05);
+}
+
+std::string format_number(double value) {
+    if (std::isnan(value)) return "n/a";
+    if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+    if (value == std::floor(value) && std::abs(value) < 1e15) return fmt::format("{:.0f}", value);
+    if (std::abs(value) >= 1000) return fmt::format("{:.0f}", value);
+    return fmt::format("{:.4g}", value);
+}
+
+Comparison compare(const std::vector<StatsFile>& runs) {
+    Comparison c;
+    for (const StatsFile& run : runs)
+        c.runs.push_back(run.path.string());
+    c.differences = setup_differences(runs);
+    c.sections.push_back(summary_section(runs));
+    c.sections.push_back(keyed_section(runs, "stall causes", "chip/stalls/", "", Better::lower));
+    c.sections.push_back(
+        keyed_section(runs, "FU utilisation", "chip/fu/", "/utilisation", Better::neutral));
+    c.sections.push_back(traffic_section(runs));
+    c.sections.push_back(per_ray_section(runs));
+    for (Section& section : c.sections)
+        std::erase_if(section.rows, [](const Row& row) { return !has_any(row); });
+    for (size_t i = 1; i < runs.size(); ++i)
+        c.images.push_back(image_difference(runs[0], runs[i]));
+    c.host = stat_row(runs, "host/run_seconds", Better::neutral);
+    return c;
+}
+
+void write_comparison(const Comparison& comparison, Format format, std::ostream& out, bool colour) {
+    switch (format) {
+    case Format::text:
+        write_text(comparison, out, colour);
+        break;
+    case Format::markdown:
+        write_markdown(comparison, out);
+        break;
+    case Format::csv:
+        write_csv(comparison, out);
+        break;
+    case Format::json:
+        write_json(comparison, out);
+        break;
+    }
+}
+
+}  // namespace tpsim::analysis

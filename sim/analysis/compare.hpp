@@ -1,0 +1,62 @@
+// `tpsim compare`: several statistics files side by side, each later run as a ratio to the
+// first, with what differs in their setup and in their images.
+#pragma once
+#include <iosfwd>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sim/analysis/images.hpp"
+#include "sim/analysis/stats_file.hpp"
+
+namespace tpsim::analysis {
+
+/// Which way a statistic improves, to tell a better run from a worse one.
+enum class Better { neutral, higher, lower };
+
+/// One statistic across the runs.
+struct Row {
+    std::string key;  ///< the statistic's key, or a name for a figure derived from several
+    std::string unit;
+    Better better = Better::neutral;
+    std::vector<std::optional<double>> values;  ///< one per run; absent where a run lacks it
+
+    /// values[run] / values[0]; 1 when both are 0; absent when either is absent, or only the
+    /// first is 0.
+    std::optional<double> ratio(size_t run) const;
+    /// True when the ratio to the first run is outside 0.95 .. 1.05.
+    bool differs_notably(size_t run) const;
+};
+
+struct Section {
+    std::string title;
+    std::vector<Row> rows;
+};
+
+/// A setup field (run field or configuration key) whose value is not the same in every run.
+struct SetupDifference {
+    std::string field;
+    std::vector<std::string> values;  ///< one per run, "(absent)" where a run lacks it
+};
+
+struct Comparison {
+    std::vector<std::string> runs;  ///< the files, as given
+    std::vector<SetupDifference> differences;
+    std::vector<Section> sections;  ///< summary, stalls, FU utilisation, traffic, per ray
+    /// images[i - 1]: run i's image against run 0's; absent when neither names an image.
+    std::vector<std::optional<ImageDifference>> images;
+    Row host;  ///< host wall time of the kernel run: shown apart, never as a result
+};
+
+Comparison compare(const std::vector<StatsFile>& runs);
+
+enum class Format { text, markdown, csv, json };
+
+/// Writes the comparison; `colour` marks notable ratios with ANSI colours (text only).
+void write_comparison(const Comparison& comparison, Format format, std::ostream& out,
+                      bool colour = false);
+
+/// A number as the tables show it: whole numbers exactly, others to 4 significant digits.
+std::string format_number(double value);
+
+}  // namespace tpsim::analysis

@@ -1,0 +1,577 @@
+#include "sim/analysis/html_report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <OpenImageIO/strutil.h>
+#include <fmt/format.h>
+
+#include "sim/analysis/page_assets.hpp"
+#include "sim/core/error.hpp"
+
+namespace tpsim::analysis {
+namespace {
+
+/// Where Debian's libjs-chart.js puts the UMD build: chart.umd.js from Chart.js 4 on,
+/// chart.min.js before (where chart.js is UMD too, but 2.7 times larger).
+constexpr const char* kChartJsCandidates[] = {"/usr/share/javascript/chart.js/chart.umd.js",
+                                              "/usr/share/javascript/chart.js/chart.min.js"};
+
+std::string escape(std::string_view text) {
+    std::string out;
+    for (char ch : text) {
+        switch (ch) {
+        case '&':
+            out += "&amp;";
+            break;
+        case '<':
+            out += "&lt;";
+            break;
+        case '>':
+            out += "&gt;";
+            break;
+        case '"':
+            out += "&quot;";
+            break;
+        default:
+            out += ch;
+        }
+    }
+    return out;
+}
+
+/// A number with a unit, shortened for a card: 2.232 ms, 54.2 M, 189.9 M.
+std::string short_number(double value) {
+    const double magnitude = std::abs(value);
+    if (magnitude >= 1e9) return fmt::format("{:.3g} G", value / 1e9);
+    if (magnitude >= 1e6) return fmt::format("{:.3g} M", value / 1e6);
+    if (magnitude >= 1e4) return fmt::format("{:.3g} k", value / 1e3);
+    return format_number(value);
+}
+
+/// One chart for the JSON blob; report_page.js draws it with Chart.js.
+struct Chart {
+    std::string type = "bar";  ///< "bar" (labels + values) or "line" ({x, y} points)
+    std::string title = "";
+    std::string unit = "";  ///< the value axis title
+    bool horizontal = false;
+    bool percent = false;
+    bool tall = false;
+    Json labels = Json::array();
+    Json datasets = Json::array();
+
+    void add(std::string label, Json data) {
+        datasets.push_back({{"label", std::move(label)}, {"data", std::move(data)}});
+    }
+    bool has_data() const {
+        for (const Json& d : datasets)
+            for (const Json& v : d["data"])
+                if ((v.is_object() ? v["y"] : v) != 0) return true;
+        return false;
+    }
+    Json to_json() const {
+        return {{"type", type},        {"title", title},
+                {"unit", unit},        {"horizontal", horizontal},
+                {"percent", percent},  {"labels", labels},
+                {"datasets", datasets}};
+    }
+};
+
+/// The page being written: HTML body text plus the charts it places.
+class Page {
+  public:
+    std::ostringstream body;
+
+    /// Places a chart (nothing when it has no nonzero value: an empty chart says nothing).
+    void chart(const Chart& chart) {
+        if (!chart.has_data()) return;
+        body << fmt::format("<div class=\"chart{}\"><canvas data-chart=\"{}\"></canvas></div>\n",
+                            chart.tall ? " tall" : "", charts_.size());
+        charts_.push_back(chart.to_json());
+    }
+
+    std::string finish(const std::string& title, const std::string& chart_js) const {
+        // "</" inside the blob would end its <script> element early.
+        std::string blob = Json{{"charts", charts_}}.dump();
+        for (size_t at = 0; (at = blob.find("</", at)) != std::string::npos; at += 3)
+            blob.replace(at, 2, "<\\/");
+        std::ostringstream page;
+        page << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+             << "<title>" << escape(title) << "</title>\n<style>\n"
+             << kReportPageCss << "</style>\n"
+             << "<script>window.tpsimErrors = []; window.addEventListener('error', function (e) "
+                "{ window.tpsimErrors.push(String(e.message)); });</script>\n"
+             << "</head>\n<body>\n<main>\n"
+             << body.str()
+             << "<footer><p id=\"chart-status\" data-status=\"pending\">charts not drawn (is "
+                "JavaScript off?)</p></footer>\n</main>\n"
+             << "<script id=\"tpsim-data\" type=\"application/json\">" << blob << "</script>\n"
+             << "<script>\n"
+             << chart_js << "\n</script>\n"
+             << "<script>\n"
+             << kReportPageJs << "</script>\n</body>\n</html>\n";
+        return page.str();
+    }
+
+  private:
+    Json charts_ = Json::array();
+};
+
+std::string image_tag(const std::filesystem::path& path, const std::string& caption) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec))
+        return fmt::format("<p class=\"note\">{}: {} does not exist.</p>\n", escape(caption),
+                           escape(path.string()));
+    return fmt::format("<figure><img alt=\"{0}\" src=\"data:image/png;base64,{1}\">"
+                       "<figcaption>{0} ({2})</figcaption></figure>\n",
+                       escape(caption), OIIO::Strutil::base64_encode(png_bytes(path)),
+                       escape(path.filename().string()));
+}
+
+std::string run_line(const StatsFile& run) {
+    std::vector<std::string> parts;
+    for (const char* key : {"kernel_name", "engine"})
+        if (!run.run_text(key).empty()) parts.push_back(escape(run.run_text(key)));
+    if (!run.run_text("width").empty())
+        parts.push_back(fmt::format("{}x{} pixels", run.run_text("width"), run.run_text("height")));
+    if (!run.run_text("samples_per_pixel").empty())
+        parts.push_back(run.run_text("samples_per_pixel") + " spp");
+    if (!run.run_text("threads").empty()) parts.push_back(run.run_text("threads") + " threads");
+    if (!run.run_text("bvh_builder").empty())
+        parts.push_back(fmt::format("BVH {}, max_leaf {}", escape(run.run_text("bvh_builder")),
+                                    run.run_text("max_leaf")));
+    std::string line;
+    for (const std::string& part : parts)
+        line += (line.empty() ? "" : " &middot; ") + part;
+    return line;
+}
+
+std::string share_cell(double share) {
+    return fmt::format("<td class=\"num\"><span class=\"bar\" style=\"width:{:.0f}px\"></span>"
+                       "{:.1f} %</td>",
+                       std::clamp(share, 0.0, 1.0) * 120, 100 * share);
+}
+
+void cards(Page& page, const StatsFile& run) {
+    struct Card {
+        const char* key;
+        const char* label;
+        double scale;
+        const char* suffix;
+    };
+    const Card list[] = {{"chip/cycles", "cycles", 1, ""},
+                         {"chip/frame_seconds", "frame time", 1e3, " ms"},
+                         {"chip/rays_per_second", "rays per second", 1, ""},
+                         {"instructions/total", "instructions", 1, ""},
+                         {"chip/issue_rate", "instructions per TP-cycle", 1, ""},
+                         {"chip/l1/hit_rate", "L1 hit rate", 100, " %"},
+                         {"chip/l2/hit_rate", "L2 hit rate", 100, " %"},
+                         {"chip/dram/bandwidth_gbps", "DRAM bandwidth", 1, " GB/s"},
+                         {"rays/total", "rays", 1, ""},
+                         {"traversal/nodes_per_ray", "nodes per ray", 1, ""},
+                         {"traversal/triangles_per_ray", "triangles per ray", 1, ""}};
+    page.body << "<section class=\"cards\">\n";
+    for (const Card& card : list)
+        if (const auto value = run.stat(card.key))
+            page.body << fmt::format("<div class=\"card\"><div class=\"value\">{}{}</div>"
+                                     "<div class=\"label\">{}</div></div>\n",
+                                     short_number(*value * card.scale), card.suffix, card.label);
+    page.body << "</section>\n";
+}
+
+/// Region names and the levels each has, from "region/<r>/<level>/<leaf>" keys (table order
+/// first, then any other region the keys name).
+std::vector<std::pair<std::string, std::vector<std::string>>> region_levels(const StatsFile& run) {
+    std::vector<std::pair<std::string, std::vector<std::string>>> regions;
+    for (const std::string& r : run.regions)
+        regions.push_back({r, {}});
+    for (const auto& [name, value] : run.stats) {
+        if (!name.starts_with("region/")) continue;
+        const size_t a = name.find('/', 7), b = name.find('/', a + 1);
+        if (a == std::string::npos || b == std::string::npos ||
+            name.find('/', b + 1) != std::string::npos)
+            continue;
+        const std::string region = name.substr(7, a - 7), level = name.substr(a + 1, b - a - 1);
+        auto found = std::find_if(regions.begin(), regions.end(),
+                                  [&](const auto& r) { return r.first == region; });
+        if (found == regions.end()) found = regions.insert(regions.end(), {region, {}});
+        if (std::find(found->second.begin(), found->second.end(), level) == found->second.end())
+            found->second.push_back(level);
+    }
+    return regions;
+}
+
+void cycles_charts(Page& page, const StatsFile& run) {
+    Chart stalls{.title = "Where TP-cycles go (share of active TP-cycles)",
+                 .horizontal = true,
+                 .percent = true};
+    const double active = run.stat("chip/active_tp_cycles").value_or(0);
+    Json shares = Json::array();
+    if (active > 0) {
+        stalls.labels.push_back("issued");
+        shares.push_back(100 * run.stat("chip/instructions").value_or(0) / active);
+        for (const auto& [name, value] : run.stats) {
+            const std::string_view rest =
+                std::string_view(name).substr(name.starts_with("chip/stalls/") ? 12 : name.size());
+            if (rest.empty() || rest.find('/') != std::string_view::npos) continue;
+            stalls.labels.push_back(std::string(rest));
+            shares.push_back(100 * value / active);
+        }
+    }
+    stalls.add("TP-cycles", shares);
+    Chart fu{.title = "Functional-unit utilisation", .horizontal = true, .percent = true};
+    Json utilisation = Json::array();
+    for (const auto& [name, value] : run.stats)
+        if (name.starts_with("chip/fu/") && name.ends_with("/utilisation")) {
+            fu.labels.push_back(name.substr(8, name.size() - 8 - 12));
+            utilisation.push_back(100 * value);
+        }
+    fu.add("busy", utilisation);
+    if (!stalls.has_data() && !fu.has_data()) return;
+    page.body << "<h2>Where the cycles go</h2>\n<div class=\"charts\">\n";
+    page.chart(stalls);
+    page.chart(fu);
+    page.body << "</div>\n";
+}
+
+void traffic(Page& page, const StatsFile& run) {
+    const auto regions = region_levels(run);
+    if (regions.empty()) return;
+    std::vector<std::string> levels;
+    for (const auto& [region, own_levels] : regions)
+        for (const std::string& level : own_levels)
+            if (std::find(levels.begin(), levels.end(), level) == levels.end())
+                levels.push_back(level);
+    Chart chart{.title = "Bytes moved by region and level", .unit = "B", .tall = true};
+    std::vector<Json> data(levels.size(), Json::array());
+    std::ostringstream table;
+    table << "<table><tr><th>region</th><th>level</th><th class=\"num\">reads</th>"
+             "<th class=\"num\">writes</th><th class=\"num\">misses</th>"
+             "<th class=\"num\">hit rate</th><th class=\"num\">payload B</th>"
+             "<th class=\"num\">moved B</th></tr>\n";
+    for (const auto& [region, own_levels] : regions) {
+        bool any = false;
+        for (const std::string& level : levels)
+            any |= run.stat("region/" + region + "/" + level + "/moved_bytes").value_or(0) != 0;
+        if (any) {
+            chart.labels.push_back(region);
+            for (size_t l = 0; l < levels.size(); ++l)
+                data[l].push_back(
+                    run.stat("region/" + region + "/" + levels[l] + "/moved_bytes").value_or(0));
+        }
+        for (const std::string& level : own_levels) {
+            const std::string prefix = "region/" + region + "/" + level + "/";
+            const auto cell = [&](const char* leaf) {
+                const auto v = run.stat(prefix + leaf);
+                return v ? format_number(*v) : std::string();
+            };
+            const auto reads = run.stat(prefix + "reads"), hits = run.stat(prefix + "hits");
+            if (run.stat(prefix + "reads").value_or(0) == 0 &&
+                run.stat(prefix + "writes").value_or(0) == 0 &&
+                run.stat(prefix + "moved_bytes").value_or(0) == 0)
+                continue;
+            table << fmt::format(
+                "<tr><td>{}</td><td>{}</td><td class=\"num\">{}</td><td "
+                "class=\"num\">{}</td><td class=\"num\">{}</td><td "
+                "class=\"num\">{}</td><td class=\"num\">{}</td><td "
+                "class=\"num\">{}</td></tr>\n",
+                escape(region), escape(level), cell("reads"), cell("writes"), cell("misses"),
+                reads && hits && *reads > 0 ? fmt::format("{:.1f} %", 100 * *hits / *reads) : "",
+                cell("payload_bytes"), cell("moved_bytes"));
+        }
+    }
+    table << "</table>\n";
+    for (size_t l = 0; l < levels.size(); ++l)
+        chart.add(levels[l], data[l]);
+    page.body << "<h2>Memory traffic by region</h2>\n";
+    page.chart(chart);
+    page.body << table.str();
+}
+
+void timeline(Page& page, const StatsFile& run) {
+    if (!run.timeline || run.timeline->rows.empty()) return;
+    const Timeline& t = *run.timeline;
+    const auto cycle = t.column("cycle");
+    if (!cycle) return;
+    const auto points = [&](size_t column, double scale) {
+        Json data = Json::array();
+        for (const auto& row : t.rows)
+            data.push_back(
+                {{"x", row[*cycle]},
+                 {"y", std::isfinite(row[column]) ? Json(scale * row[column]) : Json()}});
+        return data;
+    };
+    // Hit rates share one chart; every other column gets its own.
+    Chart hit_rates{.type = "line", .title = "Hit rates", .percent = true};
+    std::vector<Chart> charts;
+    for (size_t c = 0; c < t.columns.size(); ++c) {
+        const std::string& name = t.columns[c];
+        if (c == *cycle) continue;
+        if (name.ends_with("_hit_rate")) {
+            hit_rates.add(name.substr(0, name.size() - 9), points(c, 100));
+            continue;
+        }
+        Chart chart{.type = "line", .title = name};
+        if (name == "issue_rate") chart.title = "Issue rate (instructions per TP-cycle)";
+        if (name == "dram_bytes_per_cycle") chart.title = "DRAM bandwidth", chart.unit = "B/cycle";
+        if (name == "active_threads") chart.title = "Active threads";
+        chart.add(name, points(c, 1));
+        charts.push_back(chart);
+    }
+    if (!hit_rates.datasets.empty())
+        charts.insert(charts.begin() + std::min<size_t>(1, charts.size()), hit_rates);
+    page.body << fmt::format("<h2>Over time</h2>\n<p class=\"note\">One point per {} cycles.</p>\n"
+                             "<div class=\"charts\">\n",
+                             t.interval_cycles);
+    for (const Chart& chart : charts)
+        page.chart(chart);
+    page.body << "</div>\n";
+}
+
+void profile_table(Page& page, const std::vector<ProfileEntry>& entries, double total, bool lines) {
+    constexpr size_t kShown = 20;
+    page.body << fmt::format("<h3>Top {} by cycles{}</h3>\n<table><tr>{}<th>function</th>"
+                             "<th class=\"num\">share</th><th class=\"num\">cycles</th>"
+                             "<th class=\"num\">executions</th><th class=\"num\">stall "
+                             "cycles</th><th class=\"num\">L1 misses</th><th class=\"num\">DRAM "
+                             "B</th></tr>\n",
+                             lines ? "source lines" : "functions",
+                             entries.size() > kShown ? fmt::format(" (of {})", entries.size()) : "",
+                             lines ? "<th>line</th>" : "");
+    for (size_t i = 0; i < std::min(kShown, entries.size()); ++i) {
+        const ProfileEntry& e = entries[i];
+        double stalls = 0;
+        for (const auto& [cause, cycles] : e.stalls)
+            stalls += cycles;
+        page.body << "<tr>";
+        if (lines)
+            page.body << fmt::format("<td class=\"code\">{}:{}</td>", escape(e.file), e.line);
+        page.body << fmt::format("<td class=\"code\">{}</td>{}<td class=\"num\">{}</td><td "
+                                 "class=\"num\">{}</td><td class=\"num\">{}</td><td "
+                                 "class=\"num\">{}</td><td class=\"num\">{}</td></tr>\n",
+                                 escape(e.function), share_cell(total > 0 ? e.cycles / total : 0),
+                                 format_number(e.cycles), format_number(e.executions),
+                                 format_number(stalls), format_number(e.l1_misses),
+                                 format_number(e.dram_bytes));
+    }
+    page.body << "</table>\n";
+}
+
+void profile(Page& page, const StatsFile& run) {
+    if (!run.profile) return;
+    page.body << fmt::format("<h2>Profile</h2>\n<p class=\"note\">Shares of {} TP-cycles charged "
+                             "(issues and stalls).</p>\n",
+                             format_number(run.profile->total_cycles));
+    profile_table(page, run.profile->functions, run.profile->total_cycles, false);
+    profile_table(page, run.profile->lines, run.profile->total_cycles, true);
+}
+
+void configuration(Page& page, const StatsFile& run) {
+    if (run.config.empty()) return;
+    page.body << fmt::format("<details><summary>Resolved chip configuration ({} keys)</summary>\n"
+                             "<table><tr><th>key</th><th>value</th></tr>\n",
+                             run.config.size());
+    for (const auto& [key, value] : run.config)
+        page.body << fmt::format(
+            "<tr><td class=\"code\">{}</td><td class=\"code\">{}</td></tr>\n", escape(key),
+            escape(value.is_string() ? value.get<std::string>() : value.dump()));
+    page.body << "</table>\n</details>\n";
+}
+
+void host_line(Page& page, const std::vector<const StatsFile*>& runs) {
+    std::string line;
+    for (const StatsFile* run : runs)
+        if (const auto seconds = run->stat("host/run_seconds"))
+            line += fmt::format("{}{}: {:.3f} s", line.empty() ? "" : ", ",
+                                escape(run->path.filename().string()), *seconds);
+    if (!line.empty())
+        page.body << "<p class=\"note\">Host wall time of the kernel run (the simulator's speed, "
+                     "not a result): "
+                  << line << "</p>\n";
+}
+
+std::string run_letter(size_t run) {
+    return run < 26 ? std::string(1, char('A' + run)) : fmt::format("R{}", run + 1);
+}
+
+/// A grouped bar chart of rows from the comparison: one group per row, one bar per run.
+Chart grouped(const Comparison& c, const Section& section, std::string title, bool relative,
+              double scale = 1) {
+    Chart chart{.title = std::move(title), .percent = scale == 100};
+    if (relative) chart.unit = "relative to A";
+    for (const Row& row : section.rows)
+        chart.labels.push_back(row.key);
+    for (size_t r = 0; r < c.runs.size(); ++r) {
+        Json data = Json::array();
+        for (const Row& row : section.rows) {
+            const auto v = relative ? row.ratio(r) : row.values[r];
+            data.push_back(v && std::isfinite(*v) ? Json(scale * *v) : Json(0));
+        }
+        chart.add(run_letter(r), data);
+    }
+    return chart;
+}
+
+const Section* find_section(const Comparison& c, std::string_view title) {
+    for (const Section& s : c.sections)
+        if (s.title == title) return &s;
+    return nullptr;
+}
+
+std::string ratio_cell(const Row& row, size_t r) {
+    const auto ratio = row.ratio(r);
+    if (!ratio) return "<td class=\"num\">-</td>";
+    const char* cls = "";
+    if (row.differs_notably(r))
+        cls = row.better == Better::neutral                    ? " changed"
+              : (*ratio > 1) == (row.better == Better::higher) ? " better"
+                                                               : " worse";
+    return fmt::format("<td class=\"num{}\">{:.3f}x</td>", cls, *ratio);
+}
+
+}  // namespace
+
+std::string load_chart_js() {
+    for (const char* candidate : kChartJsCandidates) {
+        std::ifstream in(candidate, std::ios::binary);
+        if (!in) continue;
+        std::ostringstream text;
+        text << in.rdbuf();
+        // Inlined into a <script> element, which this would end.
+        if (text.str().find("</script") != std::string::npos)
+            throw Error(fmt::format("{} contains \"</script\" and cannot be inlined", candidate));
+        return text.str();
+    }
+    throw Error(fmt::format("cannot find Chart.js (looked for {} and {}); install the Debian "
+                            "package libjs-chart.js (scripts/setup does)",
+                            kChartJsCandidates[0], kChartJsCandidates[1]));
+}
+
+std::string report_page(const StatsFile& run, const std::string& chart_js) {
+    Page page;
+    const std::string scene = run.run_text("scene");
+    page.body << fmt::format("<h1>tpsim report: {}</h1>\n<p class=\"sub\">{}</p>\n"
+                             "<p class=\"sub\">statistics file {}</p>\n",
+                             escape(scene.empty() ? run.path.filename().string() : scene),
+                             run_line(run), escape(run.path.string()));
+    cards(page, run);
+    const auto image = run.run_file("image");
+    const auto heatmap = run.run_file("heatmap");
+    if (image || heatmap) {
+        page.body << "<h2>Image</h2>\n<div class=\"images\">\n";
+        if (image) page.body << image_tag(*image, "image");
+        if (heatmap) page.body << image_tag(*heatmap, "heat map");
+        page.body << "</div>\n";
+    }
+    cycles_charts(page, run);
+    traffic(page, run);
+    timeline(page, run);
+    profile(page, run);
+    if (!run.stat("chip/cycles"))
+        page.body << "<p class=\"note\">This run used the " << escape(run.run_text("engine"))
+                  << " engine: no cycles, stalls, memory traffic, timeline or profile (render "
+                     "with --timing cycle for those).</p>\n";
+    configuration(page, run);
+    host_line(page, {&run});
+    return page.finish("tpsim report: " + (scene.empty() ? run.path.string() : scene), chart_js);
+}
+
+std::string comparison_page(const std::vector<StatsFile>& runs, const Comparison& c,
+                            const std::string& chart_js) {
+    Page page;
+    page.body << "<h1>tpsim comparison</h1>\n<table><tr><th>run</th><th>statistics file</th>"
+                 "<th>scene</th><th>setup</th></tr>\n";
+    for (size_t r = 0; r < runs.size(); ++r)
+        page.body << fmt::format("<tr><td>{}</td><td class=\"code\">{}</td><td>{}</td><td>{}</td>"
+                                 "</tr>\n",
+                                 run_letter(r), escape(c.runs[r]),
+                                 escape(runs[r].run_text("scene")), run_line(runs[r]));
+    page.body << "</table>\n<h2>What differs</h2>\n";
+    if (c.differences.empty())
+        page.body << "<p class=\"note\">Nothing in the run fields or the configuration.</p>\n";
+    else {
+        page.body << "<table><tr><th>field</th>";
+        for (size_t r = 0; r < runs.size(); ++r)
+            page.body << "<th>" << run_letter(r) << "</th>";
+        page.body << "</tr>\n";
+        for (const SetupDifference& d : c.differences) {
+            page.body << "<tr><td class=\"code\">" << escape(d.field) << "</td>";
+            for (const std::string& v : d.values)
+                page.body << "<td class=\"code\">" << escape(v) << "</td>";
+            page.body << "</tr>\n";
+        }
+        page.body << "</table>\n";
+    }
+    bool any_image = false;
+    for (const StatsFile& run : runs)
+        any_image |= run.run_file("image").has_value();
+    if (any_image) {
+        page.body << "<h2>Images</h2>\n<div class=\"images\">\n";
+        for (size_t r = 0; r < runs.size(); ++r)
+            if (const auto image = runs[r].run_file("image"))
+                page.body << image_tag(*image, run_letter(r));
+        page.body << "</div>\n";
+        for (size_t i = 0; i < c.images.size(); ++i) {
+            if (!c.images[i]) continue;
+            const ImageDifference& d = *c.images[i];
+            page.body << "<p>" << run_letter(i + 1) << " against A: ";
+            if (!d.compared())
+                page.body << escape(d.note);
+            else if (d.differing_pixels == 0)
+                page.body << "identical";
+            else
+                page.body << fmt::format("RMSE {:.6f}, PSNR {:.2f} dB, {} of {} pixels differ "
+                                         "({:.2f} %)",
+                                         d.rmse, d.psnr, d.differing_pixels, d.pixels,
+                                         100 * d.differing_share());
+            page.body << "</p>\n";
+        }
+    }
+    page.body << "<h2>Side by side</h2>\n<div class=\"charts\">\n";
+    if (const Section* s = find_section(c, "summary"))
+        page.chart(grouped(c, *s, "Summary, relative to A", true));
+    if (const Section* s = find_section(c, "stall causes"))
+        page.chart(grouped(c, *s, "Stall causes (TP-cycles)", false));
+    if (const Section* s = find_section(c, "FU utilisation"))
+        page.chart(grouped(c, *s, "Functional-unit utilisation", false, 100));
+    if (const Section* s = find_section(c, "per ray"))
+        page.chart(grouped(c, *s, "Per ray, relative to A", true));
+    if (const Section* s = find_section(c, "traffic by region and level")) {
+        Section dram{"dram", {}};
+        for (const Row& row : s->rows)
+            if (row.key.ends_with("/dram/moved_bytes")) dram.rows.push_back(row);
+        for (Row& row : dram.rows)
+            row.key = row.key.substr(7, row.key.size() - 7 - 17);
+        page.chart(grouped(c, dram, "DRAM bytes moved by region", false));
+    }
+    page.body << "</div>\n";
+    for (const Section& section : c.sections) {
+        if (section.rows.empty()) continue;
+        page.body << "<h3>" << escape(section.title) << "</h3>\n<table><tr><th>statistic</th>"
+                  << "<th>unit</th>";
+        for (size_t r = 0; r < runs.size(); ++r)
+            page.body << "<th class=\"num\">" << run_letter(r) << "</th>"
+                      << (r ? "<th class=\"num\">" + run_letter(r) + "/A</th>" : "");
+        page.body << "</tr>\n";
+        for (const Row& row : section.rows) {
+            page.body << "<tr><td class=\"code\">" << escape(row.key) << "</td><td>"
+                      << escape(row.unit) << "</td>";
+            for (size_t r = 0; r < runs.size(); ++r) {
+                page.body << "<td class=\"num\">"
+                          << (row.values[r] ? format_number(*row.values[r]) : "-") << "</td>";
+                if (r) page.body << ratio_cell(row, r);
+            }
+            page.body << "</tr>\n";
+        }
+        page.body << "</table>\n";
+    }
+    std::vector<const StatsFile*> all;
+    for (const StatsFile& run : runs)
+        all.push_back(&run);
+    host_line(page, all);
+    return page.finish("tpsim comparison", chart_js);
+}
+
+}  // namespace tpsim::analysis

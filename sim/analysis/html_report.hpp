@@ -1,0 +1,23 @@
+// `tpsim report` and `tpsim compare --html`: one self-contained HTML page (images as base64
+// PNG, Chart.js inlined, all chart data in one JSON blob) that opens offline.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "sim/analysis/compare.hpp"
+#include "sim/analysis/stats_file.hpp"
+
+namespace tpsim::analysis {
+
+/// Chart.js's UMD build from Debian's libjs-chart.js, read to be inlined in a page. Throws
+/// tpsim::Error naming the package when it is not installed.
+std::string load_chart_js();
+
+/// The report of one run.
+std::string report_page(const StatsFile& run, const std::string& chart_js);
+
+/// The runs side by side, with grouped bar charts; `comparison` is compare(runs).
+std::string comparison_page(const std::vector<StatsFile>& runs, const Comparison& comparison,
+                            const std::string& chart_js);
+
+}  // namespace tpsim::analysis

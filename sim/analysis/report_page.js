@@ -1,0 +1,78 @@
+// Draws the charts of a tpsim report page from the JSON blob #tpsim-data, then records in
+// #chart-status whether every chart drew its data (the headless-browser test reads it).
+(function () {
+    'use strict';
+    const palette = ['#4e79a7', '#f28e2b', '#59a14f', '#e15759', '#76b7b2', '#b07aa1', '#edc948'];
+    const data = JSON.parse(document.getElementById('tpsim-data').textContent);
+    const failures = [];
+    let drawn = 0;
+
+    function rgb(hex) {
+        return [1, 3, 5].map(function (i) { return parseInt(hex.substr(i, 2), 16); });
+    }
+    // True when the canvas shows enough pixels of the colour: data was drawn, not only axes.
+    function showsColour(canvas, hex) {
+        const want = rgb(hex);
+        const pixels = canvas.getContext('2d').getImageData(0, 0, canvas.width, canvas.height).data;
+        let matching = 0;
+        for (let i = 0; i < pixels.length; i += 4) {
+            if (pixels[i + 3] > 200 && Math.abs(pixels[i] - want[0]) < 24 &&
+                Math.abs(pixels[i + 1] - want[1]) < 24 && Math.abs(pixels[i + 2] - want[2]) < 24)
+                matching++;
+        }
+        return matching >= 20;
+    }
+    function nonzero(dataset) {
+        return dataset.data.some(function (v) { return (typeof v === 'object' ? v.y : v) !== 0; });
+    }
+    function options(spec) {
+        const valueAxis = {
+            beginAtZero: true,
+            title: { display: !!spec.unit, text: spec.unit },
+            ticks: spec.percent ? { callback: function (v) { return v + ' %'; } } : {}
+        };
+        const categoryAxis = spec.type === 'line'
+            ? { type: 'linear', title: { display: true, text: 'cycle' } }
+            : { ticks: { autoSkip: false } };
+        return {
+            animation: false,
+            responsive: true,
+            maintainAspectRatio: false,
+            indexAxis: spec.horizontal ? 'y' : 'x',
+            plugins: {
+                title: { display: true, text: spec.title, font: { size: 14 } },
+                legend: { display: spec.datasets.length > 1 }
+            },
+            scales: spec.horizontal ? { x: valueAxis, y: categoryAxis }
+                                    : { x: categoryAxis, y: valueAxis }
+        };
+    }
+
+    data.charts.forEach(function (spec, index) {
+        const canvas = document.querySelector('canvas[data-chart="' + index + '"]');
+        try {
+            const datasets = spec.datasets.map(function (d, k) {
+                const colour = palette[k % palette.length];
+                return { label: d.label, data: d.data, backgroundColor: colour,
+                         borderColor: colour, borderWidth: spec.type === 'line' ? 2 : 0,
+                         pointRadius: 0 };
+            });
+            new Chart(canvas, { type: spec.type, data: { labels: spec.labels, datasets: datasets },
+                                options: options(spec) });
+            const shown = datasets.findIndex(function (d) { return nonzero(d); });
+            if (shown < 0 || !showsColour(canvas, datasets[shown].backgroundColor))
+                throw new Error('no data drawn');
+            canvas.dataset.drawn = 'yes';
+            drawn++;
+        } catch (e) {
+            if (canvas) canvas.dataset.drawn = 'no';
+            failures.push(spec.title + ': ' + e.message);
+        }
+    });
+
+    const errors = window.tpsimErrors.concat(failures);
+    const status = document.getElementById('chart-status');
+    status.dataset.status = errors.length === 0 && drawn === data.charts.length ? 'ok' : 'failed';
+    status.textContent = 'charts drawn: ' + drawn + ' of ' + data.charts.length + '; errors: ' +
+                         errors.length + (errors.length ? ' (' + errors.join('; ') + ')' : '');
+})();

@@ -1,0 +1,78 @@
+// `tpsim compare A.json B.json ...`: statistics files side by side, each later run as a ratio
+// to the first, as text, markdown, CSV or JSON, and optionally as an HTML page.
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include "commands.hpp"
+#include "sim/analysis/compare.hpp"
+#include "sim/analysis/html_report.hpp"
+#include "sim/core/error.hpp"
+
+namespace tpsim::cli {
+namespace {
+
+struct CompareCommandOptions {
+    std::vector<std::string> files;
+    std::string format = "text";
+    std::string output;
+    std::string html;
+};
+
+int run_compare(const CompareCommandOptions& o) {
+    if (o.files.size() < 2)
+        throw Error(fmt::format("compare needs at least two statistics files, got {}; e.g. tpsim "
+                                "compare a.json b.json",
+                                o.files.size()));
+    // Bad output paths are found before any file is read.
+    if (!o.output.empty()) check_output_path(o.output, "the comparison");
+    if (!o.html.empty()) check_output_path(o.html, "the HTML comparison");
+    std::vector<analysis::StatsFile> runs;
+    for (const std::string& file : o.files)
+        runs.push_back(analysis::load_stats_file(file));
+    const analysis::Comparison comparison = analysis::compare(runs);
+    const analysis::Format format = o.format == "markdown" ? analysis::Format::markdown
+                                    : o.format == "csv"    ? analysis::Format::csv
+                                    : o.format == "json"   ? analysis::Format::json
+                                                           : analysis::Format::text;
+    const std::string chart_js = o.html.empty() ? "" : analysis::load_chart_js();
+    if (o.output.empty()) {
+        // Colour only for a person at a terminal, never in a file or pipe.
+        analysis::write_comparison(comparison, format, std::cout,
+                                   format == analysis::Format::text && isatty(STDOUT_FILENO));
+    } else {
+        std::ostringstream text;
+        analysis::write_comparison(comparison, format, text);
+        write_output(o.output, text.str(), "the comparison");
+    }
+    if (!o.html.empty())
+        write_output(o.html, analysis::comparison_page(runs, comparison, chart_js),
+                     "the HTML comparison");
+    return 0;
+}
+
+}  // namespace
+
+Command add_compare_command(CLI::App& app) {
+    auto* command = app.add_subcommand(
+        "compare", "Compare statistics files (tpsim render --stats-json) side by side: each "
+                   "later run with its ratio to the first, and what differs in setup and image");
+    auto o = std::make_shared<CompareCommandOptions>();
+    command->add_option("files", o->files, "Statistics files (two or more); the first is the base")
+        ->required();
+    command->add_option("--format", o->format, "Output format")
+        ->check(CLI::IsMember({"text", "markdown", "csv", "json"}))
+        ->capture_default_str();
+    command->add_option("-o,--output", o->output, "Write the comparison here [default: stdout]");
+    command->add_option("--html", o->html,
+                        "Also write a self-contained HTML page with charts here");
+    return {command, [o] { return run_compare(*o); }};
+}
+
+}  // namespace tpsim::cli

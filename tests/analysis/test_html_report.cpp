@@ -1,0 +1,75 @@
+// The HTML pages as text: what they embed. (That their charts draw is checked in a headless
+// browser, see CMakeLists.txt.)
+#include <string>
+
+#include <catch2/catch.hpp>
+
+#include "sim/analysis/html_report.hpp"
+
+using namespace tpsim::analysis;
+
+namespace {
+
+const std::filesystem::path kFixtures = TPSIM_ANALYSIS_FIXTURES;
+
+/// The page's JSON blob of charts.
+Json blob_of(const std::string& page) {
+    const std::string open = "<script id=\"tpsim-data\" type=\"application/json\">";
+    const size_t start = page.find(open);
+    REQUIRE(start != std::string::npos);
+    const size_t end = page.find("</script>", start);
+    return Json::parse(page.substr(start + open.size(), end - start - open.size()));
+}
+
+size_t count(const std::string& text, const std::string& part) {
+    size_t n = 0;
+    for (size_t at = 0; (at = text.find(part, at)) != std::string::npos; at += part.size())
+        ++n;
+    return n;
+}
+
+}  // namespace
+
+TEST_CASE("report: one page embeds images, Chart.js, charts and the configuration", "[analysis]") {
+    const std::string chart_js = load_chart_js();
+    CHECK(chart_js.find("Chart") != std::string::npos);
+    const StatsFile run = load_stats_file(kFixtures / "base.json");
+    const std::string page = report_page(run, chart_js);
+    CHECK(page.find(chart_js) != std::string::npos);
+    CHECK(count(page, "<img ") == 2);  // image and heat map
+    CHECK(count(page, "src=\"data:image/png;base64,") == 2);
+    CHECK(page.find("src=\"http") == std::string::npos);  // nothing fetched: opens offline
+    const Json blob = blob_of(page);
+    // stalls, FU utilisation, traffic, 4 timeline charts (the hit rates share one)
+    CHECK(blob["charts"].size() == 7);
+    CHECK(count(page, "<canvas data-chart=") == blob["charts"].size());
+    CHECK(page.find("<details><summary>Resolved chip configuration (7 keys)") != std::string::npos);
+    CHECK(page.find("trax::rt::intersect_bvh(trax::rt::Ray const&amp;, trax::rt::Hit&amp;)") !=
+          std::string::npos);  // profile names escaped
+    CHECK(page.find("rt.hpp:123") != std::string::npos);
+    CHECK(page.find("not a result") != std::string::npos);  // host time labelled as such
+    CHECK(report_page(run, chart_js) == page);              // deterministic
+}
+
+TEST_CASE("report: a functional run gets a page without chip charts", "[analysis]") {
+    const std::string page = report_page(load_stats_file(kFixtures / "functional.json"), "");
+    CHECK(blob_of(page)["charts"].empty());
+    CHECK(page.find("functional engine: no cycles") != std::string::npos);
+}
+
+TEST_CASE("report: the comparison page has grouped charts and the side-by-side tables",
+          "[analysis]") {
+    std::vector<StatsFile> runs;
+    for (const char* name : {"base.json", "faster.json", "brute.json"})
+        runs.push_back(load_stats_file(kFixtures / name));
+    const Comparison c = compare(runs);
+    const std::string page = comparison_page(runs, c, "");
+    const Json charts = blob_of(page)["charts"];
+    REQUIRE(charts.size() == 5);
+    for (const Json& chart : charts)
+        CHECK(chart["datasets"].size() == 3);  // one per run
+    CHECK(count(page, "<img ") == 3);
+    CHECK(page.find("config l1.size_bytes") != std::string::npos);
+    CHECK(page.find("C against A: RMSE") != std::string::npos);
+    CHECK(page.find("B against A: identical") != std::string::npos);
+}
