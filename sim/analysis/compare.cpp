@@ -320,8 +320,8 @@ void write_markdown(const Comparison& c, std::ostream& out) {
     if (has_any(c.host)) {
         out << fmt::format("Host wall time (not a result), `{}`:", c.host.key);
         for (size_t r = 0; r < n; ++r)
-            out << fmt::format(" {} {} {}", run_letter(r), format_cell(c.host.values[r]),
-                               c.host.unit);
+            out << fmt::format("{} {} {} {}", r ? "," : "", run_letter(r),
+                               format_cell(c.host.values[r]), c.host.unit);
         out << "\n\n";
     }
     for (const Section& section : c.sections) {

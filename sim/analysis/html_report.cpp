@@ -396,13 +396,35 @@ std::string run_letter(size_t run) {
     return run < 26 ? std::string(1, char('A' + run)) : fmt::format("R{}", run + 1);
 }
 
+/// A key without the '/'-separated segments every row of the section shares at its start and
+/// end: "chip/fu/fp_add/utilisation" is "fp_add" among the FU utilisation rows.
+std::string distinct_part(const Section& section, const std::string& key) {
+    const auto shared_by_all = [&](auto&& shares) {
+        return std::all_of(section.rows.begin(), section.rows.end(),
+                           [&](const Row& row) { return shares(row.key); });
+    };
+    size_t start = 0;
+    for (size_t slash; (slash = key.find('/', start)) != std::string::npos; start = slash + 1) {
+        const std::string prefix = key.substr(0, slash + 1);
+        if (!shared_by_all([&](const std::string& k) { return k.starts_with(prefix); })) break;
+    }
+    size_t end = key.size();
+    for (size_t slash;
+         end > start && (slash = key.rfind('/', end - 1)) != std::string::npos && slash >= start;
+         end = slash) {
+        const std::string suffix = key.substr(slash);
+        if (!shared_by_all([&](const std::string& k) { return k.ends_with(suffix); })) break;
+    }
+    return end > start ? key.substr(start, end - start) : key;
+}
+
 /// A grouped bar chart of rows from the comparison: one group per row, one bar per run.
 Chart grouped(const Comparison& c, const Section& section, std::string title, bool relative,
               double scale = 1) {
     Chart chart{.title = std::move(title), .percent = scale == 100};
     if (relative) chart.unit = "relative to A";
     for (const Row& row : section.rows)
-        chart.labels.push_back(row.key);
+        chart.labels.push_back(distinct_part(section, row.key));
     for (size_t r = 0; r < c.runs.size(); ++r) {
         Json data = Json::array();
         for (const Row& row : section.rows) {
@@ -542,8 +564,6 @@ std::string comparison_page(const std::vector<StatsFile>& runs, const Comparison
         Section dram{"dram", {}};
         for (const Row& row : s->rows)
             if (row.key.ends_with("/dram/moved_bytes")) dram.rows.push_back(row);
-        for (Row& row : dram.rows)
-            row.key = row.key.substr(7, row.key.size() - 7 - 17);
         page.chart(grouped(c, dram, "DRAM bytes moved by region", false));
     }
     page.body << "</div>\n";

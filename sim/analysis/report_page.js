@@ -32,7 +32,7 @@
             ticks: spec.percent ? { callback: function (v) { return v + ' %'; } } : {}
         };
         const categoryAxis = spec.type === 'line'
-            ? { type: 'linear', title: { display: true, text: 'cycle' } }
+            ? { type: 'linear', min: 0, title: { display: true, text: 'cycle' } }
             : { ticks: { autoSkip: false } };
         return {
             animation: false,
