@@ -93,10 +93,11 @@ class Page {
     }
 
     std::string finish(const std::string& title, const std::string& chart_js) const {
-        // "</" inside the blob would end its <script> element early.
-        std::string blob = Json{{"charts", charts_}}.dump();
-        for (size_t at = 0; (at = blob.find("</", at)) != std::string::npos; at += 3)
-            blob.replace(at, 2, "<\\/");
+        // No '<' in the blob, so no text in it can end (or comment out) its <script> element;
+        // in JSON it can only stand inside a string, where \u003c means the same.
+        std::string blob;
+        for (char ch : Json{{"charts", charts_}}.dump())
+            blob += ch == '<' ? std::string("\\u003c") : std::string(1, ch);
         std::ostringstream page;
         page << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
              << "<title>" << escape(title) << "</title>\n<style>\n"
@@ -124,27 +125,35 @@ std::string image_tag(const std::filesystem::path& path, const std::string& capt
     if (!std::filesystem::is_regular_file(path, ec))
         return fmt::format("<p class=\"note\">{}: {} does not exist.</p>\n", escape(caption),
                            escape(path.string()));
+    std::string png;
+    try {
+        png = png_bytes(path);
+    } catch (const Error& e) {  // the rest of the page is still worth having
+        return fmt::format("<p class=\"note\">{}: {}.</p>\n", escape(caption), escape(e.what()));
+    }
     return fmt::format("<figure><img alt=\"{0}\" src=\"data:image/png;base64,{1}\">"
                        "<figcaption>{0} ({2})</figcaption></figure>\n",
-                       escape(caption), OIIO::Strutil::base64_encode(png_bytes(path)),
+                       escape(caption), OIIO::Strutil::base64_encode(png),
                        escape(path.filename().string()));
 }
 
+/// "tracer · timing · 32x32 pixels · 1 spp · 8 threads · BVH sweep, max_leaf 8", the parts
+/// the run has.
 std::string run_line(const StatsFile& run) {
+    const auto field = [&](const char* key) { return run.run_text(key); };
     std::vector<std::string> parts;
     for (const char* key : {"kernel_name", "engine"})
-        if (!run.run_text(key).empty()) parts.push_back(escape(run.run_text(key)));
-    if (!run.run_text("width").empty())
-        parts.push_back(fmt::format("{}x{} pixels", run.run_text("width"), run.run_text("height")));
-    if (!run.run_text("samples_per_pixel").empty())
-        parts.push_back(run.run_text("samples_per_pixel") + " spp");
-    if (!run.run_text("threads").empty()) parts.push_back(run.run_text("threads") + " threads");
-    if (!run.run_text("bvh_builder").empty())
-        parts.push_back(fmt::format("BVH {}, max_leaf {}", escape(run.run_text("bvh_builder")),
-                                    run.run_text("max_leaf")));
+        if (!field(key).empty()) parts.push_back(field(key));
+    if (!field("width").empty())
+        parts.push_back(fmt::format("{}x{} pixels", field("width"), field("height")));
+    if (!field("samples_per_pixel").empty()) parts.push_back(field("samples_per_pixel") + " spp");
+    if (!field("threads").empty()) parts.push_back(field("threads") + " threads");
+    if (!field("bvh_builder").empty())
+        parts.push_back(
+            fmt::format("BVH {}, max_leaf {}", field("bvh_builder"), field("max_leaf")));
     std::string line;
     for (const std::string& part : parts)
-        line += (line.empty() ? "" : " &middot; ") + part;
+        line += (line.empty() ? "" : " &middot; ") + escape(part);
     return line;
 }
 
@@ -461,13 +470,15 @@ std::string load_chart_js() {
         if (!in) continue;
         std::ostringstream text;
         text << in.rdbuf();
-        // Inlined into a <script> element, which this would end.
-        if (text.str().find("</script") != std::string::npos)
-            throw Error(fmt::format("{} contains \"</script\" and cannot be inlined", candidate));
+        // Only a UMD build defines the global Chart in a plain <script> (an ES module would not),
+        // and one with "</script" in it would end its element early.
+        if (text.str().find("define.amd") == std::string::npos ||
+            text.str().find("</script") != std::string::npos)
+            continue;
         return text.str();
     }
-    throw Error(fmt::format("cannot find Chart.js (looked for {} and {}); install the Debian "
-                            "package libjs-chart.js (scripts/setup does)",
+    throw Error(fmt::format("cannot find Chart.js's UMD build (looked for {} and {}); install "
+                            "the Debian package libjs-chart.js (scripts/setup does)",
                             kChartJsCandidates[0], kChartJsCandidates[1]));
 }
 

@@ -92,7 +92,6 @@ std::string png_bytes(const std::filesystem::path& path) {
     std::vector<unsigned char> out;
     OIIO::Filesystem::IOVecOutput proxy(out);
     OIIO::ImageSpec spec(pixels->width, pixels->height, pixels->channels, OIIO::TypeDesc::UINT8);
-    spec.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
     auto writer = OIIO::ImageOutput::create("png");
     // Float images are linear: the PNG gets the sRGB curve, as `tpsim render` writes them.
     std::vector<unsigned char> encoded(pixels->values.size());
@@ -102,7 +101,7 @@ std::string png_bytes(const std::filesystem::path& path) {
             v = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1 / 2.4f) - 0.055f;
         encoded[i] = static_cast<unsigned char>(std::lround(v * 255));
     }
-    if (!writer || !writer->open("image.png", spec) ||
+    if (!writer || !writer->set_ioproxy(&proxy) || !writer->open("image.png", spec) ||
         !writer->write_image(OIIO::TypeDesc::UINT8, encoded.data()) || !writer->close())
         throw Error(fmt::format("cannot convert image {} to PNG", path.string()));
     return std::string(out.begin(), out.end());

@@ -29,36 +29,28 @@ class Reader {
                                 where, problem));
     }
 
-    const Json& need(const Json& value, Json::value_t type, const std::string& where) const {
-        const bool ok =
-            type == Json::value_t::number_float ? value.is_number() : value.type() == type;
-        if (!ok) {
-            const Json expected_example = type == Json::value_t::number_float ? Json(0.0)
-                                          : type == Json::value_t::string     ? Json("")
-                                          : type == Json::value_t::array      ? Json::array()
-                                                                              : Json::object();
-            fail(where,
-                 fmt::format("must be {} {}, got {} {}", article(expected_example),
-                             expected_example.type_name(), article(value), value.type_name()));
-        }
-        return value;
-    }
     double number(const Json& value, const std::string& where) const {
-        return need(value, Json::value_t::number_float, where).get<double>();
+        return need(value, value.is_number(), "a number", where).get<double>();
     }
     std::string string(const Json& value, const std::string& where) const {
-        return need(value, Json::value_t::string, where).get<std::string>();
+        return need(value, value.is_string(), "a string", where).get<std::string>();
     }
     const Json& object(const Json& value, const std::string& where) const {
-        return need(value, Json::value_t::object, where);
+        return need(value, value.is_object(), "an object", where);
     }
     const Json& array(const Json& value, const std::string& where) const {
-        return need(value, Json::value_t::array, where);
+        return need(value, value.is_array(), "an array", where);
     }
 
   private:
-    static const char* article(const Json& value) {
-        return value.is_object() || value.is_array() ? "an" : "a";
+    const Json& need(const Json& value, bool ok, const char* expected,
+                     const std::string& where) const {
+        if (!ok) {
+            const char* article = value.is_object() || value.is_array() ? "an " : "a ";
+            fail(where, fmt::format("must be {}, got {}{}", expected,
+                                    value.is_null() ? "" : article, value.type_name()));
+        }
+        return value;
     }
     std::string file_;
 };
@@ -86,8 +78,10 @@ ProfileEntry read_profile_entry(const Reader& r, const Json& entry, const std::s
         for (const auto& [cause, value] : r.object(entry["stalls"], where + ".\"stalls\"").items())
             e.stalls.emplace_back(cause,
                                   r.number(value, where + ".\"stalls\"." + in_quotes(cause)));
-    if (entry.contains("l1_misses")) e.l1_misses = r.number(entry["l1_misses"], where);
-    if (entry.contains("dram_bytes")) e.dram_bytes = r.number(entry["dram_bytes"], where);
+    if (entry.contains("l1_misses"))
+        e.l1_misses = r.number(entry["l1_misses"], where + ".\"l1_misses\"");
+    if (entry.contains("dram_bytes"))
+        e.dram_bytes = r.number(entry["dram_bytes"], where + ".\"dram_bytes\"");
     return e;
 }
 

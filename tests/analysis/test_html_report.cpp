@@ -1,7 +1,9 @@
 // The HTML pages as text: what they embed. (That their charts draw is checked in a headless
 // browser, see CMakeLists.txt.)
+#include <fstream>
 #include <string>
 
+#include <OpenImageIO/imageio.h>
 #include <catch2/catch.hpp>
 
 #include "sim/analysis/html_report.hpp"
@@ -72,4 +74,49 @@ TEST_CASE("report: the comparison page has grouped charts and the side-by-side t
     CHECK(page.find("config l1.size_bytes") != std::string::npos);
     CHECK(page.find("C against A: RMSE") != std::string::npos);
     CHECK(page.find("B against A: identical") != std::string::npos);
+}
+
+TEST_CASE("report: text from the file cannot inject markup or end the data blob", "[analysis]") {
+    const StatsFile run = parse_stats_file(
+        R"({"format": "tpsim-stats", "version": 2,
+            "run": {"scene": "<script>alert(1)</script>", "kernel_name": "<b>k</b>"},
+            "stats": {"chip/cycles": 1},
+            "timeline": {"columns": ["cycle", "</script><i>"], "rows": [[1, 2]]}})",
+        kFixtures / "hostile.json");
+    const std::string page = report_page(run, "");
+    CHECK(page.find("<script>alert") == std::string::npos);
+    CHECK(page.find("&lt;script&gt;alert(1)&lt;/script&gt;") != std::string::npos);
+    CHECK(page.find("<b>k") == std::string::npos);
+    CHECK(page.find("</script><i>") == std::string::npos);
+    const Json blob = blob_of(page);  // still parses, the title intact
+    CHECK(blob.at("charts").at(0).at("title") == "</script><i>");
+}
+
+TEST_CASE("report: a float image is embedded as an sRGB PNG", "[analysis]") {
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() / "tpsim_report_img";
+    std::filesystem::create_directories(dir);
+    const float linear[] = {0.5f, 0.0f, 1.0f};
+    auto out = OIIO::ImageOutput::create((dir / "one.exr").string());
+    REQUIRE(out);
+    REQUIRE(out->open((dir / "one.exr").string(), OIIO::ImageSpec(1, 1, 3, OIIO::TypeDesc::FLOAT)));
+    REQUIRE(out->write_image(OIIO::TypeDesc::FLOAT, linear));
+    REQUIRE(out->close());
+    const std::string png = png_bytes(dir / "one.exr");
+    REQUIRE(png.substr(0, 4) == "\x89PNG");
+    std::ofstream(dir / "back.png", std::ios::binary) << png;
+    auto in = OIIO::ImageInput::open((dir / "back.png").string());
+    REQUIRE(in);
+    unsigned char rgb[3];
+    REQUIRE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, rgb));
+    CHECK(int(rgb[0]) == 188);  // sRGB(0.5) = 0.7354 -> 188
+    CHECK(int(rgb[1]) == 0);
+    CHECK(int(rgb[2]) == 255);
+    // An image that cannot be read leaves a note; the rest of the page is still written.
+    std::ofstream(dir / "broken.exr") << "not an image";
+    const StatsFile run = parse_stats_file(
+        R"({"format": "tpsim-stats", "version": 2, "run": {"image": "broken.exr"}, "stats": {}})",
+        dir / "run.json");
+    const std::string page = report_page(run, "");
+    CHECK(page.find("<p class=\"note\">image: cannot read image ") != std::string::npos);
+    std::filesystem::remove_all(dir);
 }
