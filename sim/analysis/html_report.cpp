@@ -51,6 +51,19 @@ std::string short_number(double value) {
     return format_number(value);
 }
 
+/// A number for a person reading a table: whole numbers with thousands separators (1,472,000).
+std::string readable(double value) {
+    const std::string text = format_number(value);
+    if (text.find_first_not_of("-0123456789") != std::string::npos) return text;
+    const size_t sign = text[0] == '-' ? 1 : 0, digits = text.size() - sign;
+    std::string grouped = text.substr(0, sign);
+    for (size_t i = 0; i < digits; ++i) {
+        if (i > 0 && (digits - i) % 3 == 0) grouped += ',';
+        grouped += text[sign + i];
+    }
+    return grouped;
+}
+
 /// One chart for the JSON blob; report_page.js draws it with Chart.js.
 struct Chart {
     std::string type = "bar";  ///< "bar" (labels + values) or "line" ({x, y} points)
@@ -158,9 +171,10 @@ std::string run_line(const StatsFile& run) {
 }
 
 std::string share_cell(double share) {
-    return fmt::format("<td class=\"num\"><span class=\"bar\" style=\"width:{:.0f}px\"></span>"
-                       "{:.1f} %</td>",
-                       std::clamp(share, 0.0, 1.0) * 120, 100 * share);
+    return fmt::format(
+        "<td class=\"num\"><span class=\"track\"><span class=\"bar\" "
+        "style=\"width:{:.1f}%\"></span></span><span class=\"share\">{:.1f} %</span></td>",
+        100 * std::clamp(share, 0.0, 1.0), 100 * share);
 }
 
 void cards(Page& page, const StatsFile& run) {
@@ -274,7 +288,7 @@ void traffic(Page& page, const StatsFile& run) {
             const std::string prefix = "region/" + region + "/" + level + "/";
             const auto cell = [&](const char* leaf) {
                 const auto v = run.stat(prefix + leaf);
-                return v ? format_number(*v) : std::string();
+                return v ? readable(*v) : std::string();
             };
             const auto reads = run.stat(prefix + "reads"), hits = run.stat(prefix + "hits");
             if (run.stat(prefix + "reads").value_or(0) == 0 &&
@@ -333,7 +347,7 @@ void timeline(Page& page, const StatsFile& run) {
         charts.insert(charts.begin() + std::min<size_t>(1, charts.size()), hit_rates);
     page.body << fmt::format("<h2>Over time</h2>\n<p class=\"note\">One point per {} cycles.</p>\n"
                              "<div class=\"charts\">\n",
-                             t.interval_cycles);
+                             readable(double(t.interval_cycles)));
     for (const Chart& chart : charts)
         page.chart(chart);
     page.body << "</div>\n";
@@ -361,9 +375,8 @@ void profile_table(Page& page, const std::vector<ProfileEntry>& entries, double 
                                  "class=\"num\">{}</td><td class=\"num\">{}</td><td "
                                  "class=\"num\">{}</td><td class=\"num\">{}</td></tr>\n",
                                  escape(e.function), share_cell(total > 0 ? e.cycles / total : 0),
-                                 format_number(e.cycles), format_number(e.executions),
-                                 format_number(stalls), format_number(e.l1_misses),
-                                 format_number(e.dram_bytes));
+                                 readable(e.cycles), readable(e.executions), readable(stalls),
+                                 readable(e.l1_misses), readable(e.dram_bytes));
     }
     page.body << "</table>\n";
 }
@@ -372,7 +385,7 @@ void profile(Page& page, const StatsFile& run) {
     if (!run.profile) return;
     page.body << fmt::format("<h2>Profile</h2>\n<p class=\"note\">Shares of {} TP-cycles charged "
                              "(issues and stalls).</p>\n",
-                             format_number(run.profile->total_cycles));
+                             readable(run.profile->total_cycles));
     profile_table(page, run.profile->functions, run.profile->total_cycles, false);
     profile_table(page, run.profile->lines, run.profile->total_cycles, true);
 }
@@ -591,7 +604,7 @@ std::string comparison_page(const std::vector<StatsFile>& runs, const Comparison
                       << escape(row.unit) << "</td>";
             for (size_t r = 0; r < runs.size(); ++r) {
                 page.body << "<td class=\"num\">"
-                          << (row.values[r] ? format_number(*row.values[r]) : "-") << "</td>";
+                          << (row.values[r] ? readable(*row.values[r]) : "-") << "</td>";
                 if (r) page.body << ratio_cell(row, r);
             }
             page.body << "</tr>\n";
