@@ -3,23 +3,17 @@
 #include <algorithm>
 #include <cstring>
 
-#include "sim/core/elf_loader.hpp"
 
 namespace tpsim::render {
 
-std::shared_ptr<TimingRun> run_timing(const std::filesystem::path& kernel_elf,
-                                      image::MemoryImage& image, const timing::ChipConfig& chip,
+std::shared_ptr<TimingRun> run_timing(const core::Program& program, image::MemoryImage& image,
+                                      const timing::ChipConfig& chip,
                                       uint64_t max_instructions, uint64_t pixels,
                                       const ProgressCallback& on_progress) {
-    core::MachineConfig config = timing::machine_config_for(chip);
-    config.global_bytes = uint32_t(image.bytes());
-    config.read_only_global_bytes = uint32_t(image.read_only_bytes());
-    config.max_instructions = max_instructions;
-
     auto run = std::make_shared<TimingRun>();
-    run->machine = std::make_unique<core::Machine>(core::load_elf(kernel_elf), config);
+    run->machine =
+        timing::make_machine(program, image.words, image.read_only_bytes(), chip, max_instructions);
     core::Machine& machine = *run->machine;
-    std::memcpy(machine.memory().global().data(), image.words.data(), image.bytes());
     run->source = std::make_unique<timing::MachineSource>(machine);
     run->chip = std::make_unique<timing::Chip>(chip, *run->source);
 

@@ -22,11 +22,10 @@ struct TimingRun {
     InstructionCounts instructions;
 };
 
-/// Runs `kernel_elf` over `image` (in place) on the chip `chip`. `pixels` scales the progress
+/// Runs `program` over `image` (in place) on the chip `chip`. `pixels` scales the progress
 /// reports, which come every timing::Chip::kProgressInterval cycles. Throws core::Fault on a
 /// guest fault and std::runtime_error on a timing deadlock.
-std::shared_ptr<TimingRun> run_timing(const std::filesystem::path& kernel_elf,
-                                      image::MemoryImage& image, const timing::ChipConfig& chip,
+std::shared_ptr<TimingRun> run_timing(const core::Program& program, image::MemoryImage& image, const timing::ChipConfig& chip,
                                       uint64_t max_instructions, uint64_t pixels = 0,
                                       const ProgressCallback& on_progress = {});
 
