@@ -17,13 +17,14 @@ std::shared_ptr<TimingRun> run_timing(const core::Program& program, image::Memor
     run->source = std::make_unique<timing::MachineSource>(machine);
     run->chip = std::make_unique<timing::Chip>(chip, *run->source);
 
-    timing::Chip::ProgressHook hook;
-    if (on_progress)
-        hook = [&](uint64_t cycles) {
-            // Threads take one pixel past the end before they stop, hence the cap.
-            on_progress({std::min<uint64_t>(machine.global_register(0), pixels), pixels, cycles});
-        };
-    run->chip->run(UINT64_MAX, hook);
+    // Paused every kProgressInterval cycles for the progress report. Threads take one pixel
+    // past the end before they stop, hence the cap.
+    timing::Chip& model = *run->chip;
+    constexpr uint64_t kInterval = timing::Chip::kProgressInterval;
+    for (uint64_t until = kInterval; !model.run_until(until); until += kInterval)
+        if (on_progress)
+            on_progress({std::min<uint64_t>(machine.global_register(0), pixels), pixels,
+                         model.cycles()});
     std::memcpy(image.words.data(), machine.memory().global().data(), image.bytes());
 
     run->instructions = InstructionCounts::of(machine.counters());

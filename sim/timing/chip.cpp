@@ -151,39 +151,48 @@ Chip::Chip(const ChipConfig& config, InstructionSource& source)
         tms_.back()->running = config.chip.tps_per_tm;
     }
     for (uint32_t g = 0; g < config.num_l2(); ++g) l2s_.emplace_back(config.l2);
-    // The machine's cycle CSRs read this chip's clock. During the tick of cycle `now`,
-    // cycles_ == now, so an instruction sees the cycle it is fetched (and executed) in.
-    if (auto* machine = dynamic_cast<MachineSource*>(&source_))
-        machine->machine().set_cycle_counter(&cycles_);
+}
+
+Chip::Chip(const ChipConfig& config, MachineSource& source)
+    : Chip(config, static_cast<InstructionSource&>(source)) {
+    run_cycles_ = &Chip::run_cycles<MachineSource>;
+    // During the tick of cycle `now`, cycles_ == now, so an instruction sees the cycle it is
+    // fetched (and executed) in.
+    clocked_machine_ = &source.machine();
+    clocked_machine_->set_cycle_counter(&cycles_);
 }
 
 Chip::~Chip() {
-    if (auto* machine = dynamic_cast<MachineSource*>(&source_))
-        machine->machine().set_cycle_counter(nullptr);
+    if (clocked_machine_) clocked_machine_->set_cycle_counter(nullptr);
 }
 
-uint64_t Chip::run(uint64_t max_cycles, const ProgressHook& on_progress) {
-    if (auto* machine = dynamic_cast<MachineSource*>(&source_))
-        return run_with(*machine, max_cycles, on_progress);
-    return run_with(source_, max_cycles, on_progress);
+bool Chip::run_until(uint64_t cycle) { return (this->*run_cycles_)(cycle); }
+
+uint64_t Chip::run(uint64_t max_cycles) {
+    if (!run_until(max_cycles))
+        throw std::runtime_error(fmt::format(
+            "timing: the chip did not finish within {} cycles; raise the cycle limit",
+            max_cycles));
+    return cycles_;
+}
+
+bool Chip::busy() const {
+    for (const auto& tm : tms_)
+        if (tm->running || tm->l1.outstanding_misses() || !tm->l1.outbound().empty()) return true;
+    for (const Cache& l2 : l2s_)
+        if (l2.outstanding_misses() || !l2.outbound().empty()) return true;
+    return !dram_.idle() || !global_registers_.idle();
 }
 
 template <class Source>
-uint64_t Chip::run_with(Source& source, uint64_t max_cycles, const ProgressHook& on_progress) {
-    uint64_t last_progress = 0, last_progress_cycle = 0;
-    auto busy = [&] {
-        for (const auto& tm : tms_)
-            if (tm->running || tm->l1.outstanding_misses() || !tm->l1.outbound().empty())
-                return true;
-        for (const Cache& l2 : l2s_)
-            if (l2.outstanding_misses() || !l2.outbound().empty()) return true;
-        return !dram_.idle() || !global_registers_.idle();
-    };
-    for (uint64_t now = cycles_; busy(); ++now) {
-        if (now >= max_cycles)
-            throw std::runtime_error(fmt::format(
-                "timing: the chip did not finish within {} cycles; raise the cycle limit",
-                max_cycles));
+bool Chip::run_cycles(uint64_t end) {
+    // The constructor chose Source to be the source's own type.
+    Source& source = static_cast<Source&>(source_);
+    for (uint64_t now = cycles_; now < end && !finished_; ++now) {
+        if (!busy()) {
+            finished_ = true;
+            break;
+        }
         tick_shared(now);
         // TMs of up to 64 TPs (one word per bit set) take a loop without word loops.
         if (config_.chip.tps_per_tm <= 64)
@@ -191,22 +200,22 @@ uint64_t Chip::run_with(Source& source, uint64_t max_cycles, const ProgressHook&
         else
             for (auto& tm : tms_) tick_tm<Source, 0>(*tm, now, source);
         cycles_ = now + 1;
-        if (on_progress && cycles_ % kProgressInterval == 0) on_progress(cycles_);
-        if (progress_ != last_progress) {
-            last_progress = progress_;
-            last_progress_cycle = now;
-        } else if (now - last_progress_cycle > kDeadlockCycles) {
+        if (progress_ != last_progress_) {
+            last_progress_ = progress_;
+            last_progress_cycle_ = now;
+        } else if (now - last_progress_cycle_ > kDeadlockCycles) {
             throw std::runtime_error(fmt::format(
                 "timing: deadlock, nothing issued or returned for {} cycles (cycle {}); "
                 "this is a simulator bug, please report it with the config",
                 kDeadlockCycles, now));
         }
     }
+    finished_ = finished_ || !busy();
     for (const auto& tm : tms_)
         for (const Tm::Tp& tp : tm->tps)
             local_store_high_water_ = std::max<uint64_t>(local_store_high_water_,
                                                          trax::map::kLocalTop - tp.lowest_local);
-    return cycles_;
+    return finished_;
 }
 
 // Shared parts, in a fixed order: replies DRAM -> L2 -> L1, then requests L1 -> L2 -> DRAM

@@ -20,7 +20,6 @@
 #include <array>
 #include <cstdint>
 #include <deque>
-#include <functional>
 #include <memory>
 #include <vector>
 
@@ -50,20 +49,29 @@ enum class Stall : uint8_t {
     Count
 };
 
+class MachineSource;  // machine_source.hpp
+
 class Chip {
 public:
+    /// Any instruction source (e.g. a test's scripted one), called through its virtuals.
     Chip(const ChipConfig& config, InstructionSource& source);
+    /// The functional machine: its calls inline into the cycle loop, and its cycle CSRs read
+    /// this chip's clock while the chip lives.
+    Chip(const ChipConfig& config, MachineSource& source);
     ~Chip();
 
-    /// Called by run() every kProgressInterval cycles with the cycle count, e.g. for a progress
-    /// display; it must not touch the chip or its source.
-    using ProgressHook = std::function<void(uint64_t cycles)>;
+    /// How often callers looping over run_until() usually report progress.
     static constexpr uint64_t kProgressInterval = 1 << 16;
 
-    /// Runs until every thread has exited and all memory traffic has drained; returns the
-    /// cycle count. Throws std::runtime_error if nothing progresses for a long time (deadlock)
-    /// or `max_cycles` pass.
-    uint64_t run(uint64_t max_cycles = UINT64_MAX, const ProgressHook& on_progress = {});
+    /// Runs cycles until `cycle` (exclusive) or until the chip has finished (every thread
+    /// exited, all memory traffic drained); returns finished(). Calls continue where the last
+    /// one stopped, so a run can pause and resume at any cycle with the same result. Throws
+    /// std::runtime_error if nothing issues or returns for a long time (deadlock).
+    bool run_until(uint64_t cycle);
+    bool finished() const { return finished_; }
+    /// Runs to the end; returns the cycle count. Throws std::runtime_error on a deadlock or if
+    /// the chip has not finished by cycle `max_cycles`.
+    uint64_t run(uint64_t max_cycles = UINT64_MAX);
 
     uint64_t cycles() const { return cycles_; }
     /// Registers every counter under tm<i>/..., l2/<j>/..., dram/..., global_registers/...,
@@ -73,15 +81,18 @@ public:
 private:
     struct Tm;
     // The cycle loop is instantiated for the concrete MachineSource (its calls inline) and for
-    // any other InstructionSource (tests' scripted sources).
+    // any other InstructionSource (tests' scripted sources); the constructor picks one.
     template <class Source>
-    uint64_t run_with(Source& source, uint64_t max_cycles, const ProgressHook& on_progress);
+    bool run_cycles(uint64_t end);
+    bool busy() const;
     void tick_shared(uint64_t now);
     template <class Source, uint32_t kWords>  // kWords: words per TP bit set, 0 = any
     void tick_tm(Tm& tm, uint64_t now, Source& source);
 
     ChipConfig config_;
     InstructionSource& source_;
+    bool (Chip::*run_cycles_)(uint64_t end) = &Chip::run_cycles<InstructionSource>;
+    core::Machine* clocked_machine_ = nullptr;  // reads cycles_ through its cycle CSRs
     std::vector<std::unique_ptr<Tm>> tms_;
     std::vector<Cache> l2s_;
     Dram dram_;
@@ -90,6 +101,8 @@ private:
     std::array<uint32_t, size_t(Pool::Count)> latency_of_{};
     uint64_t cycles_ = 0;
     uint64_t progress_ = 0;  // bumped whenever anything issues or returns
+    uint64_t last_progress_ = 0, last_progress_cycle_ = 0;  // for the deadlock detector
+    bool finished_ = false;
     uint64_t local_store_high_water_ = 0;  // bytes, max over threads
 };
 

@@ -138,8 +138,10 @@ struct ChipRun {
     std::vector<uint32_t> global;      // global memory afterwards (framebuffer included)
 };
 
+/// Runs the tracer on the 32x32 Cornell box; with `pause_every`, in run_until() steps of that
+/// many cycles.
 template <class Source>
-ChipRun run_chip(const timing::ChipConfig& chip) {
+ChipRun run_chip(const timing::ChipConfig& chip, uint64_t pause_every = 0) {
     const scene::Scene scene = scene::load_scene(small_cornell());
     scene::BvhConfig bvh_config;
     bvh_config.traversal_stack_entries = trax::layout::kTraversalStackEntries;
@@ -152,7 +154,13 @@ ChipRun run_chip(const timing::ChipConfig& chip) {
     core::Machine& machine = *machine_ptr;
     Source source(machine);
     timing::Chip model(chip, source);
-    model.run();
+    if (pause_every == 0)
+        model.run();
+    else
+        for (uint64_t until = pause_every; !model.run_until(until); until += pause_every)
+            REQUIRE(model.cycles() == until);
+    CHECK(model.finished());
+    CHECK(model.run_until(model.cycles() + 1));  // a finished chip stays finished
     stats::Registry registry;
     model.register_stats(registry);
     ChipRun run;
@@ -178,5 +186,17 @@ TEST_CASE("running threads ahead through private instructions changes nothing th
         CHECK(ahead.stats == at_fetch.stats);
         CHECK(ahead.global == at_fetch.global);
         CHECK(ahead.stats.find("chip/instructions=0\n") == std::string::npos);
+    }
+}
+
+TEST_CASE("a run paused and resumed at any cycle gives the run without pauses",
+          "[render][determinism]") {
+    const timing::ChipConfig chip = tiny();
+    const ChipRun whole = run_chip<timing::MachineSource>(chip);
+    for (uint64_t pause_every : {1u, 997u, 65536u}) {
+        INFO(pause_every);
+        const ChipRun paused = run_chip<timing::MachineSource>(chip, pause_every);
+        CHECK(paused.stats == whole.stats);
+        CHECK(paused.global == whole.global);
     }
 }
