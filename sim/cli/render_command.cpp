@@ -89,6 +89,7 @@ struct RenderCommandOptions {
     std::string timing = "cycle";
     std::string stats_json;
     bool verbose = false;
+    uint64_t timeline_cycles = 0;
     uint64_t max_instructions = uint64_t(1) << 32;
 };
 
@@ -100,6 +101,7 @@ int run_render(const RenderCommandOptions& o) {
                      : o.timing == "cycle" ? render::Engine::timing
                                            : render::Engine::functional;
     options.max_instructions = o.max_instructions;
+    options.timeline_interval = o.timeline_cycles;
     if (!o.config.empty()) options.chip = timing::load_config(o.config);
     for (const std::string& assignment : o.overrides) timing::apply_override(options.chip, assignment);
     options.bvh.builder = o.bvh == "binned" ? scene::BvhBuilder::binned : scene::BvhBuilder::sweep;
@@ -189,6 +191,10 @@ Command add_render_command(CLI::App& app) {
     command->add_flag("-v,--verbose", o->verbose,
                       "Also print the resolved chip configuration and every statistic "
                       "(docs/statistics.md)");
+    command->add_option("--timeline-cycles", o->timeline_cycles,
+                        "Cycles per row of the statistics file's timeline; 0: adapt to the run "
+                        "(200-400 rows)")
+        ->capture_default_str();
     command->add_option("--max-instructions", o->max_instructions,
                         "Instructions a thread may run before it is stopped as a runaway")
         ->check(kPositiveCount)

@@ -61,7 +61,8 @@ InstructionCounts run_kernel(const Kernel& kernel, Engine engine, image::MemoryI
                             chip.chip.tps_per_tm);
             break;
         case Engine::timing:
-            return run_timing(kernel.program, image, chip, max_instructions)->instructions;
+            return run_timing(kernel.program, image, chip, {.max_instructions = max_instructions})
+                ->instructions;
     }
     return {};
 }
@@ -90,9 +91,9 @@ RenderResult render(const RenderOptions& options) {
     start = std::chrono::steady_clock::now();
     if (options.engine == Engine::timing) {
         result.timing = run_timing(kernel.program, result.image, options.chip,
-                                   options.max_instructions,
-                                   uint64_t(result.scene.width) * result.scene.height,
-                                   options.on_progress);
+                                   {options.max_instructions,
+                                    uint64_t(result.scene.width) * result.scene.height,
+                                    options.on_progress, options.timeline_interval});
         result.instructions = result.timing->instructions;
     } else {
         result.instructions = run_kernel(kernel, options.engine, result.image,

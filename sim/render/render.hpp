@@ -63,6 +63,7 @@ struct RenderOptions {
     timing::ChipConfig chip;       ///< shape (TMs x TPs) and local-store size
     uint64_t max_instructions = uint64_t(1) << 32;  ///< per thread, for runaway kernels
     ProgressCallback on_progress;  ///< Engine::timing calls it now and then while it runs
+    uint64_t timeline_interval = 0;  ///< Engine::timing: cycles per timeline row, 0 = adapt
 };
 
 /// Instruction counts of a simulated run.

@@ -194,6 +194,7 @@ nlohmann::ordered_json stats_document(const RenderOptions& options, const Render
     }
     doc["stats"] = stats::values_json(snapshot);
     doc["units"] = stats::units_json(snapshot);
+    if (r.timing) doc["timeline"] = r.timing->timeline->json();
     return doc;
 }
 

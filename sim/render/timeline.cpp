@@ -9,9 +9,9 @@ namespace {
 // The chip counters a row is computed from (cumulative since cycle 0).
 constexpr const char* kCounterNames[] = {
     "chip/instructions", "chip/l1/hits",    "chip/l1/reads",      "chip/l2/hits",
-    "chip/l2/reads",     "dram/bytes_read", "dram/bytes_written", "chip/active_tp_cycles",
+    "chip/l2/reads",     "dram/bytes_read", "dram/bytes_written",
 };
-enum Counter { Instructions, L1Hits, L1Reads, L2Hits, L2Reads, DramRead, DramWritten, Active };
+enum Counter { Instructions, L1Hits, L1Reads, L2Hits, L2Reads, DramRead, DramWritten, Running };
 constexpr uint64_t kFirstInterval = 1024;
 
 double ratio(uint64_t numerator, uint64_t denominator) {
@@ -20,19 +20,22 @@ double ratio(uint64_t numerator, uint64_t denominator) {
 
 }  // namespace
 
-Timeline::Timeline(const stats::Registry& chip_stats, uint32_t threads, uint64_t interval)
-    : threads_(threads),
+Timeline::Timeline(const stats::Registry& chip_stats, uint32_t threads,
+                   std::function<uint64_t()> running, uint64_t interval)
+    : running_(std::move(running)),
+      threads_(threads),
       adaptive_(interval == 0),
       interval_(interval == 0 ? kFirstInterval : interval),
       next_(interval_) {
-    static_assert(std::size(kCounterNames) == kCounters);
+    static_assert(std::size(kCounterNames) + 1 == kCounters);
     for (const char* name : kCounterNames) counters_.push_back(chip_stats.at(name));
     points_.push_back({});
 }
 
 void Timeline::sample(uint64_t cycle) {
     Point p{cycle};
-    for (size_t i = 0; i < kCounters; ++i) p[i + 1] = counters_[i].integer();
+    for (size_t i = 0; i < counters_.size(); ++i) p[i + 1] = counters_[i].integer();
+    p[Running + 1] = running_();
     points_.push_back(p);
     next_ = cycle + interval_;
     if (adaptive_ && points_.size() > 2 * kTargetRows) {
@@ -61,9 +64,7 @@ nlohmann::ordered_json Timeline::json() const {
         rows.push_back({b[0], ratio(delta(Instructions), cycles * threads_),
                         ratio(delta(L1Hits), delta(L1Reads)), ratio(delta(L2Hits), delta(L2Reads)),
                         ratio(delta(DramRead) + delta(DramWritten), cycles),
-                        // TP-cycles of threads not yet exited, per cycle: the average number of
-                        // active threads over the interval.
-                        ratio(delta(Active), cycles)});
+                        b[Running + 1]});
     }
     doc["rows"] = std::move(rows);
     return doc;

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "render.hpp"
+#include "timeline.hpp"
 #include "sim/core/machine.hpp"
 #include "sim/image/memory_image.hpp"
 #include "sim/timing/chip.hpp"
@@ -19,14 +20,22 @@ struct TimingRun {
     std::unique_ptr<core::Machine> machine;
     std::unique_ptr<timing::MachineSource> source;
     std::unique_ptr<timing::Chip> chip;
+    std::unique_ptr<Timeline> timeline;
     InstructionCounts instructions;
 };
 
-/// Runs `program` over `image` (in place) on the chip `chip`. `pixels` scales the progress
-/// reports, which come every timing::Chip::kProgressInterval cycles. Throws core::Fault on a
-/// guest fault and std::runtime_error on a timing deadlock.
-std::shared_ptr<TimingRun> run_timing(const core::Program& program, image::MemoryImage& image, const timing::ChipConfig& chip,
-                                      uint64_t max_instructions, uint64_t pixels = 0,
-                                      const ProgressCallback& on_progress = {});
+/// How a cycle-level run is watched while it runs.
+struct TimingRunOptions {
+    uint64_t max_instructions = uint64_t(1) << 32;  ///< per thread, for runaway kernels
+    uint64_t pixels = 0;           ///< scales the progress reports (0: none)
+    ProgressCallback on_progress;  ///< every timing::Chip::kProgressInterval cycles
+    uint64_t timeline_interval = 0;  ///< cycles between timeline samples; 0: adapt (Timeline)
+};
+
+/// Runs `program` over `image` (in place) on the chip `chip`. Throws core::Fault on a guest
+/// fault and std::runtime_error on a timing deadlock.
+std::shared_ptr<TimingRun> run_timing(const core::Program& program, image::MemoryImage& image,
+                                      const timing::ChipConfig& chip,
+                                      const TimingRunOptions& options = {});
 
 }  // namespace tpsim::render

@@ -74,6 +74,8 @@ public:
     uint64_t run(uint64_t max_cycles = UINT64_MAX);
 
     uint64_t cycles() const { return cycles_; }
+    /// Threads that have not exited yet.
+    uint32_t running_threads() const;
     /// Registers every counter under tm<i>/..., l2/<j>/..., dram/..., global_registers/...,
     /// and chip-wide sums under chip/... . The chip and `registry` must outlive the printing.
     void register_stats(stats::Registry& registry) const;

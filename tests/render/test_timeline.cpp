@@ -3,6 +3,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <functional>
+
 using namespace tpsim;
 
 namespace {
@@ -11,9 +13,10 @@ namespace {
 /// each of its threads and reads one L1 line per cycle (hitting every other cycle).
 struct FakeChip {
     uint64_t instructions = 0, l1_hits = 0, l1_reads = 0, l2_hits = 0, l2_reads = 0;
-    uint64_t dram_read = 0, dram_written = 0, active = 0;
+    uint64_t dram_read = 0, dram_written = 0;
+    uint32_t running;
     stats::Registry registry;
-    FakeChip() {
+    explicit FakeChip(uint32_t threads) : running(threads) {
         registry.add_counter("chip/instructions", instructions, "");
         registry.add_counter("chip/l1/hits", l1_hits, "");
         registry.add_counter("chip/l1/reads", l1_reads, "");
@@ -21,27 +24,30 @@ struct FakeChip {
         registry.add_counter("chip/l2/reads", l2_reads, "");
         registry.add_counter("dram/bytes_read", dram_read, "");
         registry.add_counter("dram/bytes_written", dram_written, "");
-        registry.add_counter("chip/active_tp_cycles", active, "");
+    }
+    std::function<uint64_t()> running_threads() {
+        return [this] { return running; };
     }
     void tick(uint64_t cycle, uint32_t threads) {
         instructions += threads / 2;
         ++l1_reads;
         l1_hits += cycle % 2;
         dram_read += 64;
-        active += threads;
+        running = threads;
     }
 };
 
 }  // namespace
 
 TEST_CASE("a fixed-interval timeline reports the rates of each interval", "[render][timeline]") {
-    FakeChip chip;
-    render::Timeline timeline(chip.registry, 4, 100);
+    FakeChip chip(4);
+    render::Timeline timeline(chip.registry, 4, chip.running_threads(), 100);
     uint64_t cycle = 0;
     for (; cycle < 1050; ++cycle) {
         if (cycle == timeline.next_sample()) timeline.sample(cycle);
         chip.tick(cycle, 4);
     }
+    chip.running = 1;        // three threads have exited by the end
     timeline.sample(cycle);  // the run's end, mid-interval
     const auto doc = timeline.json();
     CHECK(doc["interval_cycles"] == 100);
@@ -54,14 +60,15 @@ TEST_CASE("a fixed-interval timeline reports the rates of each interval", "[rend
         CHECK(row[2].get<double>() == Approx(0.5));   // every other read hits
         CHECK(row[3].get<double>() == 0.0);           // no L2 reads: 0, not NaN
         CHECK(row[4].get<double>() == Approx(64.0));  // B/cycle
-        CHECK(row[5].get<double>() == Approx(4.0));   // active threads
     }
+    CHECK(rows[9][5] == 4);  // threads running at each sample
+    CHECK(rows[10][5] == 1);
 }
 
 TEST_CASE("an adaptive timeline keeps about 200 rows however long the run", "[render][timeline]") {
     for (uint64_t length : {5'000ull, 300'000ull, 3'000'000ull}) {
-        FakeChip chip;
-        render::Timeline timeline(chip.registry, 2);
+        FakeChip chip(2);
+        render::Timeline timeline(chip.registry, 2, chip.running_threads());
         uint64_t cycle = 0;
         for (; cycle < length; ++cycle) {
             if (cycle == timeline.next_sample()) timeline.sample(cycle);
