@@ -48,6 +48,7 @@ constexpr uint32_t kMaxMagnify = 16; ///< bounds the PNG of a tiny, oddly shaped
 constexpr int kLegendHeight = 50;    ///< the strip below the map
 constexpr int kMargin = 10;          ///< around the bar, left and right
 constexpr int kBarTop = 10, kBarHeight = 14, kTextBaseline = 42, kFontSize = 14;
+constexpr int kTextRow = 20, kTextGap = 12; ///< a second row of text; the least space between texts
 constexpr std::array<float, 3> kBackground = {0.10f, 0.10f, 0.11f};
 constexpr std::array<float, 3> kFrame = {0.55f, 0.55f, 0.55f};
 constexpr std::array<float, 3> kText = {0.92f, 0.92f, 0.92f};
@@ -156,9 +157,22 @@ HeatmapFiles write_heatmap(const std::filesystem::path& png_path,
     const double low = *lowest, range = *highest - *lowest;
     const auto colour = [&](double v) { return inferno(range > 0 ? float((v - low) / range) : 0); };
 
+    namespace algo = OIIO::ImageBufAlgo;
+    const std::string low_text = grouped(low), high_text = grouped(*highest);
+    const std::string label(kMetricLabels[size_t(metric)]);
+    const auto text_width = [](const std::string& text) {
+        const OIIO::ROI size = algo::text_size(text, kFontSize, kFont);
+        return size.defined() ? size.width() : 0;
+    };
+
     const uint32_t magnify = std::clamp((kMinWidth + width - 1) / width, 1u, kMaxMagnify);
     const int map_width = int(width * magnify), map_height = int(height * magnify);
-    Canvas canvas(std::max(map_width, int(kMinWidth)), map_height + kLegendHeight);
+    const int canvas_width = std::max(map_width, int(kMinWidth));
+    // The label sits centred between the minimum and the maximum, or on a row of its own below
+    // them when the numbers are too wide for that.
+    const int room = (canvas_width - text_width(label)) / 2 - kMargin - kTextGap;
+    const bool label_row = std::max(text_width(low_text), text_width(high_text)) > room;
+    Canvas canvas(canvas_width, map_height + kLegendHeight + (label_row ? kTextRow : 0));
     const int left = (canvas.width - map_width) / 2;
     for (int y = 0; y < map_height; ++y)
         for (int x = 0; x < map_width; ++x)
@@ -179,13 +193,11 @@ HeatmapFiles write_heatmap(const std::filesystem::path& png_path,
     png_spec.attribute("tpsim:metric", std::string(metric_name(metric)));
     OIIO::ImageBuf png(png_spec, canvas.rgb.data());
     const int baseline = map_height + kTextBaseline;
-    const std::string label(kMetricLabels[size_t(metric)]);
-    namespace algo = OIIO::ImageBufAlgo;
     const bool text =
-        algo::render_text(png, bar_left, baseline, grouped(low), kFontSize, kFont, kText) &&
-        algo::render_text(png, canvas.width / 2, baseline, label, kFontSize, kFont, kText,
-                          algo::TextAlignX::Center) &&
-        algo::render_text(png, bar_right, baseline, grouped(*highest), kFontSize, kFont, kText,
+        algo::render_text(png, bar_left, baseline, low_text, kFontSize, kFont, kText) &&
+        algo::render_text(png, canvas.width / 2, baseline + (label_row ? kTextRow : 0), label,
+                          kFontSize, kFont, kText, algo::TextAlignX::Center) &&
+        algo::render_text(png, bar_right, baseline, high_text, kFontSize, kFont, kText,
                           algo::TextAlignX::Right);
     if (!text)
         files.legend_problem = fmt::format(

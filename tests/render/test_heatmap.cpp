@@ -131,6 +131,15 @@ TEST_CASE("heat map: the PNG maps the values to inferno with a legend below", "[
         for (int x = 0; x < png.width; ++x)
             text_pixels += png.at(x, y, 0) > 200 && png.at(x, y, 2) > 200; // white, not yellow
     CHECK(text_pixels > 100);
+
+    // Numbers too wide to share a row with the label push it onto a row of its own.
+    for (timing::WorkItemCounters& item : costs.items)
+        item.cycles *= 1'000'000'000;
+    const Pixels wide = read(
+        render::write_heatmap(scratch("ramp_wide.png"), costs, w, h, render::HeatMetric::Cycles)
+            .png);
+    CHECK(wide.width == png.width);
+    CHECK(wide.height > png.height);
 }
 
 TEST_CASE("heat map: the same costs give the same bytes", "[heatmap]") {
