@@ -68,9 +68,8 @@ Profile profile_of(const timing::PcProfile& words, const core::Program& program)
             entry = {
                 source->file, source->path, source->line, in.empty() ? entry.function : in, {}};
         }
-        auto [line, inserted] =
-            lines.try_emplace({entry.path, entry.line, entry.function}, std::move(entry));
-        line->second.costs += costs;
+        auto key = std::tuple(entry.path, entry.line, entry.function);
+        lines.try_emplace(std::move(key), std::move(entry)).first->second.costs += costs;
     }
 
     for (auto& [address, function] : functions)
