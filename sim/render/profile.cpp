@@ -142,6 +142,8 @@ std::string short_function_name(std::string_view name) {
         const char c = name[i];
         depth += c == '<' ? 1 : c == '>' ? -1 : 0;
         if (depth > 0 && c == ':' && i + 1 < parameters && name[i + 1] == ':') {
+            if (shown.ends_with("(anonymous namespace)"))
+                shown.resize(shown.size() - std::string_view("(anonymous namespace)").size());
             while (!shown.empty() &&
                    (std::isalnum((unsigned char)shown.back()) || shown.back() == '_'))
                 shown.pop_back();

@@ -267,6 +267,7 @@ TEST_CASE("profile: short function names drop return types, parameters and names
                               "BvhTraversal const&)") == "trax::rt::render_image<BvhTraversal>");
     CHECK(short_function_name("(anonymous namespace)::depth(int)") ==
           "(anonymous namespace)::depth");
+    CHECK(short_function_name("void f<(anonymous namespace)::Tag, 3>(int)") == "f<Tag, 3>");
     CHECK(short_function_name("trax_main") == "trax_main");
     CHECK(short_function_name(render::kUnknown) == render::kUnknown);
 }
