@@ -60,9 +60,11 @@ InstructionCounts run_kernel(const Kernel& kernel, Engine engine, image::MemoryI
                             chip.chip.num_tms * chip.chip.tps_per_tm, chip.chip.num_tms,
                             chip.chip.tps_per_tm);
             break;
-        case Engine::timing:
-            return run_timing(kernel.program, image, chip, {.max_instructions = max_instructions})
-                ->instructions;
+        case Engine::timing: {
+            TimingRunOptions watch;
+            watch.max_instructions = max_instructions;
+            return run_timing(kernel.program, image, chip, watch)->instructions;
+        }
     }
     return {};
 }
