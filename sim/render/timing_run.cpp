@@ -21,7 +21,7 @@ std::shared_ptr<TimingRun> run_timing(const std::filesystem::path& kernel_elf,
     core::Machine& machine = *run->machine;
     std::memcpy(machine.memory().global().data(), image.words.data(), image.bytes());
     run->source = std::make_unique<timing::MachineSource>(machine);
-    run->chip = std::make_unique<timing::Chip>(chip, *run->source);
+    run->chip = std::make_unique<timing::Chip>(chip, *run->source, chip_layout(image, machine));
 
     // Paused every kProgressInterval cycles for the progress report. Threads take one pixel
     // past the end before they stop, hence the cap.

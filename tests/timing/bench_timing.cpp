@@ -4,6 +4,7 @@
 // before and after an optimisation (they must be identical).
 #include "sim/core/elf_loader.hpp"
 #include "sim/image/memory_image.hpp"
+#include "sim/render/timing_run.hpp"  // chip_layout() only (inline): no image-file libraries
 #include "sim/scene/bvh.hpp"
 #include "sim/scene/load_scene.hpp"
 #include "timing/machine_source.hpp"
@@ -36,7 +37,7 @@ int main(int argc, char** argv) try {
     core::Machine machine(core::load_elf(argv[2]), config);
     std::memcpy(machine.memory().global().data(), image.words.data(), image.bytes());
     timing::MachineSource source(machine);
-    timing::Chip model(chip, source);
+    timing::Chip model(chip, source, render::chip_layout(image, machine));
 
     const std::clock_t start = std::clock();
     model.run();
