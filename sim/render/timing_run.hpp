@@ -8,6 +8,7 @@
 #include "render.hpp"
 #include "timeline.hpp"
 #include "sim/core/machine.hpp"
+#include "kernel/memory_map.hpp"
 #include "sim/image/memory_image.hpp"
 #include "sim/timing/chip.hpp"
 #include "sim/timing/machine_source.hpp"
@@ -23,6 +24,25 @@ struct TimingRun {
     std::unique_ptr<Timeline> timeline;
     InstructionCounts instructions;
 };
+
+/// What the chip is told about a run: the image's non-empty sections as regions, the
+/// kernel's text, and one work item per pixel (per ray for a ray batch).
+inline timing::ChipLayout chip_layout(const image::MemoryImage& image,
+                                      const core::Machine& machine) {
+    timing::ChipLayout layout;
+    for (const image::SectionSize& section : image.sections)
+        if (section.bytes != 0)
+            layout.regions.push_back({section.name,
+                                      uint32_t(trax::map::kGlobalBase + section.begin),
+                                      uint32_t(trax::map::kGlobalBase + section.begin +
+                                               section.bytes)});
+    layout.text_base = machine.text_base();
+    layout.text_words = machine.text_words();
+    const auto& header = image.header;
+    layout.work_items = uint32_t(header.rays.count > 0 ? header.rays.count
+                                                       : header.framebuffer.count);
+    return layout;
+}
 
 /// How a cycle-level run is watched while it runs.
 struct TimingRunOptions {

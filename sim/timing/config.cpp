@@ -57,6 +57,7 @@ void for_each_field(Config& c, Visit&& visit) {
     };
     cache("l1", c.l1);
     cache("l2", c.l2);
+    visit("l2.write_combining_lines", c.l2.write_combining_lines, Range{0, 4096});
     visit("dram.channels", c.dram.channels, Range{1, 256});
     visit("dram.banks", c.dram.banks, Range{1, 256});
     visit("dram.row_bytes", c.dram.row_bytes, Range{64, 1u << 20});

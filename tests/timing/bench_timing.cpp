@@ -4,6 +4,7 @@
 // before and after an optimisation (they must be identical).
 #include "sim/core/elf_loader.hpp"
 #include "sim/image/memory_image.hpp"
+#include "sim/render/timing_run.hpp"  // chip_layout() only (inline): no image-file libraries
 #include "sim/scene/bvh.hpp"
 #include "sim/scene/load_scene.hpp"
 #include "timing/machine_source.hpp"
@@ -34,7 +35,7 @@ int main(int argc, char** argv) try {
                                                   image.read_only_bytes(), chip, uint64_t(1) << 32);
     core::Machine& machine = *machine_ptr;
     timing::MachineSource source(machine);
-    timing::Chip model(chip, source);
+    timing::Chip model(chip, source, render::chip_layout(image, machine));
 
     const std::clock_t start = std::clock();
     model.run();

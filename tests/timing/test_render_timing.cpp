@@ -91,6 +91,7 @@ TEST_CASE("timing parameters never change the image", "[render][invariance]") {
         {"dram.tCL=40", "dram.tRP=30"},
         {"fu.fp_mul.count=4", "fu.fp_add.latency=7"},
         {"global_registers.latency=50", "icache.banks=1"},
+        {"l2.write_combining_lines=2", "l2.size_bytes=4096"},
     };
     uint64_t previous_cycles = 0;
     for (const auto& overrides : variants) {
