@@ -97,6 +97,9 @@ class Machine {
     Thread& thread(uint32_t id) { return threads_.at(id); }
     const Thread& thread(uint32_t id) const { return threads_.at(id); }
     uint32_t thread_count() const { return uint32_t(threads_.size()); }
+    /// The executable range: text_words() instruction words from text_base().
+    uint32_t text_base() const { return text_base_; }
+    uint32_t text_words() const { return text_bytes_ / 4; }
     const Counters& counters() const { return counters_; }
     uint32_t global_register(uint32_t index) const { return global_registers_.at(index); }
 

@@ -157,7 +157,8 @@ MemoryImage build_memory_image(const scene::Scene& scene, const scene::Bvh* bvh,
         write(image.words, h.rays.addr + int32_t(i) * layout::kRayWords, rays[i]);
 
     const auto section = [](const char* name, const layout::SectionRef& ref, int32_t words) {
-        return SectionSize{name, uint32_t(ref.count), uint64_t(ref.count) * uint64_t(words) * 4};
+        return SectionSize{name, uint32_t(ref.count), uint64_t(ref.count) * uint64_t(words) * 4,
+                           uint64_t(ref.addr) * 4};
     };
     image.header = h;
     image.sections = {

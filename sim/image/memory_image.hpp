@@ -12,11 +12,13 @@
 
 namespace tpsim::image {
 
-/// One section of the image, for the "memory image by section" report.
+/// One section of the image, for the "memory image by section" report and the chip's
+/// traffic by region.
 struct SectionSize {
     std::string name;
     uint32_t records = 0;
     uint64_t bytes = 0;
+    uint64_t begin = 0;  ///< byte offset from trax::map::kGlobalBase
 };
 
 struct MemoryImage {

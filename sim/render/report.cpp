@@ -9,6 +9,19 @@
 
 namespace tpsim::render {
 
+namespace {
+
+std::string_view engine_name(Engine engine) {
+    switch (engine) {
+        case Engine::functional: return "functional";
+        case Engine::native: return "native";
+        case Engine::timing: return "timing";
+    }
+    return "";
+}
+
+}  // namespace
+
 void register_stats(const RenderResult& r, stats::Registry& reg) {
     const auto number = [&reg](std::string name, auto get, std::string description,
                                std::string unit = "") {
@@ -94,6 +107,17 @@ void print_summary(const RenderOptions& options, const RenderResult& r, std::ost
                : options.engine == Engine::timing ? "the cycle-level chip model"
                                                   : "the functional simulator",
                options.chip.chip.num_tms, options.chip.chip.tps_per_tm, r.threads);
+    std::string changed;
+    const std::vector<timing::ConfigField> defaults = timing::config_fields({});
+    const std::vector<timing::ConfigField> fields = timing::config_fields(options.chip);
+    for (size_t i = 0; i < fields.size(); ++i)
+        if (fields[i].value != defaults[i].value)
+            changed += fmt::format("{}{}={}", changed.empty() ? "" : ", ", fields[i].key,
+                                   fields[i].is_bool ? (fields[i].value ? "true" : "false")
+                                                     : std::to_string(fields[i].value));
+    fmt::print(out, "config   {}\n",
+               changed.empty() ? "the defaults (configs/trax.toml)"
+                               : "the defaults (configs/trax.toml) except " + changed);
     fmt::print(out, "memory   {:.1f} KiB ({:.1f} KiB read-only scene):", double(r.image.bytes()) / 1024,
                double(r.image.read_only_bytes()) / 1024);
     const char* separator = " ";
@@ -133,6 +157,45 @@ void print_summary(const RenderOptions& options, const RenderResult& r, std::ost
                    double(r.instructions.total) / r.run_seconds / 1e6);
     else
         fmt::print(out, "run      {:.3f} s\n", r.run_seconds);
+}
+
+nlohmann::ordered_json stats_document(const RenderOptions& options, const RenderResult& r,
+                                      const stats::Snapshot& snapshot,
+                                      const std::filesystem::path& json_path,
+                                      const OutputPaths& outputs) {
+    const std::filesystem::path base = json_path.has_parent_path()
+                                           ? json_path.parent_path()
+                                           : std::filesystem::path(".");
+    const auto relative = [&](const std::filesystem::path& path) {
+        return std::filesystem::proximate(path, base).generic_string();
+    };
+    nlohmann::ordered_json doc;
+    doc["format"] = "tpsim-stats";
+    doc["version"] = kStatsFileVersion;
+    nlohmann::ordered_json& run = doc["run"];
+    run["scene"] = options.scene.generic_string();
+    run["kernel"] = options.kernel.generic_string();
+    run["kernel_name"] = options.kernel.stem().string();
+    run["engine"] = engine_name(options.engine);
+    run["bvh_builder"] = options.bvh.builder == scene::BvhBuilder::binned ? "binned" : "sweep";
+    run["max_leaf"] = options.bvh.max_leaf_size;
+    run["width"] = r.scene.width;
+    run["height"] = r.scene.height;
+    run["samples_per_pixel"] = r.scene.samples_per_pixel;
+    run["threads"] = r.threads;
+    run["image"] = relative(outputs.image);
+    if (!outputs.heatmap.empty()) run["heatmap"] = relative(outputs.heatmap);
+    nlohmann::ordered_json& config = doc["config"];
+    for (const timing::ConfigField& field : timing::config_fields(options.chip)) {
+        if (field.is_bool)
+            config[field.key] = field.value != 0;
+        else
+            config[field.key] = field.value;
+    }
+    doc["stats"] = stats::values_json(snapshot);
+    doc["units"] = stats::units_json(snapshot);
+    if (r.timing) doc["timeline"] = r.timing->timeline->json();
+    return doc;
 }
 
 }  // namespace tpsim::render

@@ -28,6 +28,14 @@ struct Region {
     uint32_t begin = 0, end = 0;
 };
 
+/// One region's traffic at one level (l1, l2 or dram); docs/statistics.md defines each figure
+/// per level. DRAM has no hits or misses (they stay 0).
+struct LevelTraffic {
+    uint64_t reads = 0, writes = 0, hits = 0, misses = 0, merged_misses = 0;
+    uint64_t payload_bytes = 0;  ///< bytes the kernel's loads and stores asked of this level
+    uint64_t moved_bytes = 0;    ///< bytes this level moved to or from the level below
+};
+
 /// What the chip is told about the program and the memory it runs over (not configuration:
 /// it follows from the scene and the kernel).
 struct ChipLayout {

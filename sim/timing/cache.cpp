@@ -9,7 +9,7 @@
 
 namespace tpsim::timing {
 
-Cache::Cache(const CacheConfig& config)
+Cache::Cache(const CacheConfig& config, uint32_t write_combining_lines)
     : config_(config),
       num_sets_(config.size_bytes / (config.ways * config.line_bytes)),
       line_shift_(static_cast<uint32_t>(std::countr_zero(config.line_bytes))),
@@ -17,7 +17,8 @@ Cache::Cache(const CacheConfig& config)
       set_mod_(std::max(num_sets_, 1u)),
       ways_(size_t{num_sets_} * config.ways),
       mshrs_(config.mshrs),
-      bank_used_at_(config.banks, UINT64_MAX) {
+      bank_used_at_(config.banks, UINT64_MAX),
+      combining_capacity_(write_combining_lines) {
     if (num_sets_ == 0 || (config.line_bytes & (config.line_bytes - 1)) != 0)
         throw std::invalid_argument(
             "Cache: invalid geometry; validate the ChipConfig before building caches");
@@ -55,6 +56,7 @@ CacheOutcome Cache::access(uint64_t now, const MemRequest& request) {
         bank_used = now;
         ++counters_.writes;
         if (Way* way = find(line)) way->last_use = ++use_clock_;
+        if (combining_capacity_ != 0) return combine(after_lookup, request);
         outbound_.push_back({after_lookup, request});
         return CacheOutcome::WriteForward;
     }
@@ -84,6 +86,12 @@ CacheOutcome Cache::access(uint64_t now, const MemRequest& request) {
     bank_used = now;
     ++counters_.reads;
     ++counters_.misses;
+    // The line's buffered stores reach the next level before the line is read from it.
+    for (size_t i = 0; i < combining_.size(); ++i)
+        if (combining_[i].first.addr == line) {
+            write_line(i, after_lookup);
+            break;
+        }
     free_mshr->busy = true;
     free_mshr->line = line;
     free_mshr->waiters.assign(1, request);
@@ -91,6 +99,42 @@ CacheOutcome Cache::access(uint64_t now, const MemRequest& request) {
     line_request.addr = line;
     outbound_.push_back({after_lookup, line_request});
     return CacheOutcome::Miss;
+}
+
+CacheOutcome Cache::combine(uint64_t at, const MemRequest& request) {
+    const uint32_t line = line_of(request.addr);
+    size_t index = 0;
+    while (index < combining_.size() && combining_[index].first.addr != line) ++index;
+    if (index == combining_.size()) {
+        if (combining_.size() == combining_capacity_) {
+            write_line(0, at);  // the oldest line makes room
+            --index;
+        }
+        CombiningLine opened{request, std::vector<uint64_t>((config_.line_bytes + 63) / 64), 0};
+        opened.first.addr = line;
+        combining_.push_back(std::move(opened));
+    }
+    CombiningLine& entry = combining_[index];
+    for (uint32_t b = request.addr - line; b < request.addr - line + request.bytes; ++b) {
+        uint64_t& word = entry.written[b / 64];
+        entry.bytes += (word >> (b % 64) & 1) ^ 1;
+        word |= uint64_t{1} << (b % 64);
+    }
+    if (entry.bytes == config_.line_bytes) write_line(index, at);
+    return CacheOutcome::WriteCombined;
+}
+
+void Cache::write_line(size_t index, uint64_t at) {
+    MemRequest write = combining_[index].first;
+    write.bytes = static_cast<uint16_t>(combining_[index].bytes);
+    outbound_.push_back({at, write});
+    combining_.erase(combining_.begin() + static_cast<std::ptrdiff_t>(index));
+}
+
+bool Cache::drain_write_buffer(uint64_t now) {
+    const bool any = !combining_.empty();
+    while (!combining_.empty()) write_line(0, now);
+    return any;
 }
 
 void Cache::fill(uint64_t now, uint32_t line_addr) {

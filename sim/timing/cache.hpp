@@ -3,7 +3,8 @@
 //
 // Policy (docs/hardware-model.md): reads allocate; stores are write-around (as in TRaX): a store
 // is forwarded to the next level, never allocates, and leaves a present line valid; stores need
-// no reply. Each bank accepts one access per cycle; bank = line number % banks. Fills do not
+// no reply. Optionally (the L2's write_combining_lines) stores merge in a small buffer of lines
+// and go on as one line write each. Each bank accepts one access per cycle; bank = line number % banks. Fills do not
 // occupy a bank. Data values are never stored: the functional core owns them.
 #pragma once
 #include "stats/registry.hpp"
@@ -38,6 +39,7 @@ enum class CacheOutcome : uint8_t {
     Miss,          ///< a line request went to the next level
     MergedMiss,    ///< joined an outstanding miss to the same line
     WriteForward,  ///< store accepted and forwarded (write-around)
+    WriteCombined, ///< store accepted into the write-combining buffer
     BankConflict,  ///< bank already used this cycle: nothing happened, retry next cycle
     MshrFull,      ///< no MSHR free: nothing happened, retry later
 };
@@ -59,7 +61,8 @@ public:
         uint64_t evictions = 0;       ///< valid lines replaced by fills
     };
 
-    explicit Cache(const CacheConfig& config);
+    /// `write_combining_lines` > 0 adds a write-combining buffer of that many lines.
+    explicit Cache(const CacheConfig& config, uint32_t write_combining_lines = 0);
 
     /// Presents one access in cycle `now`; calls must come in non-decreasing `now`.
     CacheOutcome access(uint64_t now, const MemRequest& request);
@@ -81,6 +84,10 @@ public:
     uint32_t line_of(uint32_t addr) const { return addr & ~(config_.line_bytes - 1); }
     uint32_t bank_of(uint32_t addr) const { return bank_mod_.of(addr >> line_shift_); }
     uint32_t outstanding_misses() const;
+    /// End of the run: every line in the write-combining buffer goes on as a line write, oldest
+    /// first, visible below from `now`. Returns whether there were any.
+    bool drain_write_buffer(uint64_t now);
+    bool holds_combined_lines() const { return !combining_.empty(); }
 
     const Counters& counters() const { return counters_; }
     const CacheConfig& config() const { return config_; }
@@ -98,7 +105,18 @@ private:
         std::vector<MemRequest> waiters;
     };
 
+    /// A line being written in the write-combining buffer: which bytes, and the request that
+    /// opened it (its region, pc and work item go on with the line write).
+    struct CombiningLine {
+        MemRequest first;
+        std::vector<uint64_t> written;  // bit per byte of the line
+        uint32_t bytes = 0;             // bits set in `written`
+    };
+
     Way* find(uint32_t line);
+    CacheOutcome combine(uint64_t now, const MemRequest& request);
+    /// Sends buffered line `index` on as one line write, visible below from `at`.
+    void write_line(size_t index, uint64_t at);
     const Way* find(uint32_t line) const;
     uint32_t set_of(uint32_t line) const { return set_mod_.of(line >> line_shift_); }
 
@@ -113,6 +131,8 @@ private:
     uint64_t use_clock_ = 0;
     std::deque<MemReply> replies_;        // non-decreasing `ready`
     std::deque<OutboundRequest> outbound_;
+    uint32_t combining_capacity_;
+    std::vector<CombiningLine> combining_;  // oldest first
     Counters counters_;
 };
 

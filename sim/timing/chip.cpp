@@ -6,6 +6,8 @@
 
 #include <fmt/format.h>
 
+#include <fmt/ranges.h>
+
 #include <algorithm>
 #include <bit>
 #include <utility>
@@ -30,6 +32,22 @@ uint64_t longest_timed_sleep(const ChipConfig& c) {
     const uint64_t bubble = std::max(c.tp.branch_taken_penalty, c.tp.branch_not_taken_penalty);
     return std::max(fu + c.tp.local_store_latency, bubble + 1);
 }
+
+/// Counts an accepted cache access in its region's traffic; `payload` and `moved` are the bytes
+/// docs/statistics.md defines for the level.
+void count_access(LevelTraffic& t, CacheOutcome outcome, uint64_t payload, uint64_t moved) {
+    t.payload_bytes += payload;
+    t.moved_bytes += moved;
+    switch (outcome) {
+    case CacheOutcome::Hit: ++t.reads, ++t.hits; break;
+    case CacheOutcome::Miss: ++t.reads, ++t.misses; break;
+    case CacheOutcome::MergedMiss: ++t.reads, ++t.merged_misses; break;
+    default: ++t.writes; break;  // WriteForward, WriteCombined
+    }
+}
+
+/// Region names that the chip's own region/ keys use.
+constexpr std::string_view kReservedRegions[] = {"other", "local_store", "instruction_fetch"};
 
 }  // namespace
 
@@ -59,15 +77,16 @@ struct Chip::Tm {
         std::array<uint64_t, size_t(isa::FuClass::Count)> per_class{};
         uint64_t local_loads = 0;
         uint64_t local_stores = 0;
+        uint64_t local_payload_bytes = 0;
     };
 
-    Tm(const ChipConfig& c, uint32_t id)
+    Tm(const ChipConfig& c, uint32_t id, size_t regions)
         : id(id), words((c.chip.tps_per_tm + 63) / 64), tps(c.chip.tps_per_tm),
           icache(c.icache, c.chip.tps_per_tm), l1(c.l1), awake_tps(words), pending_tps(words),
           needs_port_tps(words), mem_waiting_tps(words), issuing_tps(words),
           wheel_slots(std::min(std::bit_ceil(longest_timed_sleep(c) + 1), kMaxWheelSlots)),
           sleeps_outlast_wheel(longest_timed_sleep(c) >= wheel_slots),
-          wheel(wheel_slots * words) {
+          wheel(wheel_slots * words), l1_traffic(regions) {
         for (uint32_t i = 0; i < c.chip.tps_per_tm; ++i) set_bit(awake_tps, i);
         for (size_t p = 0; p < kPools; ++p)
             pools.emplace_back(pool_config(c.fu, Pool(p)), c.chip.tps_per_tm);
@@ -136,54 +155,136 @@ struct Chip::Tm {
     bool sleeps_outlast_wheel;
     TpBits wheel;
     Counters counters;
+    std::vector<LevelTraffic> l1_traffic;  // by region
 };
 
-Chip::Chip(const ChipConfig& config, InstructionSource& source)
+Chip::Chip(const ChipConfig& config, InstructionSource& source, const ChipLayout& layout)
     : config_(config),
+      layout_(layout),
       source_(source),
       dram_(config.dram, config.l2.line_bytes),
       global_registers_(config.global_registers) {
     validate(config_);
+    if (layout.regions.size() >= UINT8_MAX)
+        throw std::invalid_argument(fmt::format("Chip: {} regions; at most {} fit a request's tag",
+                                                layout.regions.size(), UINT8_MAX - 1));
+    for (size_t r = 0; r < layout.regions.size(); ++r) {
+        const Region& region = layout.regions[r];
+        const bool reserved = std::find(std::begin(kReservedRegions), std::end(kReservedRegions),
+                                        region.name) != std::end(kReservedRegions);
+        if (region.name.empty() || region.name.find('/') != std::string::npos || reserved ||
+            region.begin >= region.end)
+            throw std::invalid_argument(fmt::format(
+                "Chip: region '{}' [{:#x}, {:#x}) needs a name (not {}) without '/' and bytes",
+                region.name, region.begin, region.end, fmt::join(kReservedRegions, ", ")));
+        for (size_t q = 0; q < r; ++q)
+            if (layout.regions[q].name == region.name)
+                throw std::invalid_argument(
+                    fmt::format("Chip: two regions are called '{}'", region.name));
+        region_bounds_.push_back({region.begin, region.end, uint8_t(r)});
+    }
+    std::sort(region_bounds_.begin(), region_bounds_.end(),
+              [](const RegionBounds& a, const RegionBounds& b) { return a.begin < b.begin; });
+    for (size_t r = 1; r < region_bounds_.size(); ++r)
+        if (region_bounds_[r].begin < region_bounds_[r - 1].end)
+            throw std::invalid_argument(fmt::format(
+                "Chip: regions '{}' and '{}' overlap",
+                layout.regions[region_bounds_[r - 1].index].name,
+                layout.regions[region_bounds_[r].index].name));
+    other_region_ = uint8_t(layout.regions.size());
+    const size_t regions = layout.regions.size() + 1;
+    l1_traffic_.resize(regions);
+    l2_traffic_.resize(regions);
+    dram_traffic_.resize(regions);
+
     for (size_t fu = 0; fu < pool_of_.size(); ++fu) pool_of_[fu] = pool_of(isa::FuClass(fu));
     for (size_t p = 0; p < kPools; ++p) latency_of_[p] = pool_config(config.fu, Pool(p)).latency;
     for (uint32_t t = 0; t < config.chip.num_tms; ++t) {
-        tms_.push_back(std::make_unique<Tm>(config, t));
+        tms_.push_back(std::make_unique<Tm>(config, t, regions));
         tms_.back()->running = config.chip.tps_per_tm;
     }
-    for (uint32_t g = 0; g < config.num_l2(); ++g) l2s_.emplace_back(config.l2);
-    // The machine's cycle CSRs read this chip's clock. During the tick of cycle `now`,
-    // cycles_ == now, so an instruction sees the cycle it is fetched (and executed) in.
-    if (auto* machine = dynamic_cast<MachineSource*>(&source_))
-        machine->machine().set_cycle_counter(&cycles_);
+    for (uint32_t g = 0; g < config.num_l2(); ++g)
+        l2s_.emplace_back(config.l2, config.l2.write_combining_lines);
+}
+
+Chip::Chip(const ChipConfig& config, MachineSource& source, const ChipLayout& layout)
+    : Chip(config, static_cast<InstructionSource&>(source), layout) {
+    run_cycles_ = &Chip::run_cycles<MachineSource>;
+    // During the tick of cycle `now`, cycles_ == now, so an instruction sees the cycle it is
+    // fetched (and executed) in.
+    clocked_machine_ = &source.machine();
+    clocked_machine_->set_cycle_counter(&cycles_);
 }
 
 Chip::~Chip() {
-    if (auto* machine = dynamic_cast<MachineSource*>(&source_))
-        machine->machine().set_cycle_counter(nullptr);
+    if (clocked_machine_) clocked_machine_->set_cycle_counter(nullptr);
 }
 
-uint64_t Chip::run(uint64_t max_cycles, const ProgressHook& on_progress) {
-    if (auto* machine = dynamic_cast<MachineSource*>(&source_))
-        return run_with(*machine, max_cycles, on_progress);
-    return run_with(source_, max_cycles, on_progress);
+bool Chip::run_until(uint64_t cycle) { return (this->*run_cycles_)(cycle); }
+
+uint64_t Chip::run(uint64_t max_cycles) {
+    if (!run_until(max_cycles))
+        throw std::runtime_error(fmt::format(
+            "timing: the chip did not finish within {} cycles; raise the cycle limit",
+            max_cycles));
+    return cycles_;
+}
+
+bool Chip::busy() const {
+    for (const auto& tm : tms_)
+        if (tm->running || tm->l1.outstanding_misses() || !tm->l1.outbound().empty()) return true;
+    for (const Cache& l2 : l2s_)
+        if (l2.outstanding_misses() || !l2.outbound().empty()) return true;
+    return !dram_.idle() || !global_registers_.idle();
+}
+
+bool Chip::drained() const {
+    return !busy() && std::none_of(l2s_.begin(), l2s_.end(), [](const Cache& l2) {
+        return l2.holds_combined_lines();
+    });
+}
+
+uint8_t Chip::region_of(uint32_t addr) const {
+    // The last region starting at or below addr, if addr is inside it.
+    const auto after = std::upper_bound(
+        region_bounds_.begin(), region_bounds_.end(), addr,
+        [](uint32_t a, const RegionBounds& r) { return a < r.begin; });
+    if (after == region_bounds_.begin() || addr >= after[-1].end) return other_region_;
+    return after[-1].index;
+}
+
+void Chip::collect() {
+    std::fill(l1_traffic_.begin(), l1_traffic_.end(), LevelTraffic{});
+    local_payload_bytes_ = 0;
+    for (const auto& tm : tms_) {
+        for (size_t r = 0; r < l1_traffic_.size(); ++r) {
+            LevelTraffic& sum = l1_traffic_[r];
+            const LevelTraffic& t = tm->l1_traffic[r];
+            sum.reads += t.reads, sum.writes += t.writes, sum.hits += t.hits;
+            sum.misses += t.misses, sum.merged_misses += t.merged_misses;
+            sum.payload_bytes += t.payload_bytes, sum.moved_bytes += t.moved_bytes;
+        }
+        local_payload_bytes_ += tm->counters.local_payload_bytes;
+        for (const Tm::Tp& tp : tm->tps)
+            local_store_high_water_ = std::max<uint64_t>(local_store_high_water_,
+                                                         trax::map::kLocalTop - tp.lowest_local);
+    }
 }
 
 template <class Source>
-uint64_t Chip::run_with(Source& source, uint64_t max_cycles, const ProgressHook& on_progress) {
-    uint64_t last_progress = 0, last_progress_cycle = 0;
-    auto busy = [&] {
-        for (const auto& tm : tms_)
-            if (tm->running || tm->l1.outstanding_misses() || !tm->l1.outbound().empty())
-                return true;
-        for (const Cache& l2 : l2s_)
-            if (l2.outstanding_misses() || !l2.outbound().empty()) return true;
-        return !dram_.idle() || !global_registers_.idle();
-    };
-    for (uint64_t now = cycles_; busy(); ++now) {
-        if (now >= max_cycles)
-            throw std::runtime_error(fmt::format(
-                "timing: the chip did not finish within {} cycles; raise the cycle limit",
-                max_cycles));
+bool Chip::run_cycles(uint64_t end) {
+    // The constructor chose Source to be the source's own type.
+    Source& source = static_cast<Source&>(source_);
+    for (uint64_t now = cycles_; now < end && !finished_; ++now) {
+        if (!busy()) {
+            // Every thread has exited: the write-combining buffers drain, then the chip is done.
+            bool drained_lines = false;
+            for (Cache& l2 : l2s_) drained_lines |= l2.drain_write_buffer(now);
+            if (!drained_lines) {
+                finished_ = true;
+                break;
+            }
+        }
         tick_shared(now);
         // TMs of up to 64 TPs (one word per bit set) take a loop without word loops.
         if (config_.chip.tps_per_tm <= 64)
@@ -191,22 +292,25 @@ uint64_t Chip::run_with(Source& source, uint64_t max_cycles, const ProgressHook&
         else
             for (auto& tm : tms_) tick_tm<Source, 0>(*tm, now, source);
         cycles_ = now + 1;
-        if (on_progress && cycles_ % kProgressInterval == 0) on_progress(cycles_);
-        if (progress_ != last_progress) {
-            last_progress = progress_;
-            last_progress_cycle = now;
-        } else if (now - last_progress_cycle > kDeadlockCycles) {
+        if (progress_ != last_progress_) {
+            last_progress_ = progress_;
+            last_progress_cycle_ = now;
+        } else if (now - last_progress_cycle_ > kDeadlockCycles) {
             throw std::runtime_error(fmt::format(
                 "timing: deadlock, nothing issued or returned for {} cycles (cycle {}); "
                 "this is a simulator bug, please report it with the config",
                 kDeadlockCycles, now));
         }
     }
-    for (const auto& tm : tms_)
-        for (const Tm::Tp& tp : tm->tps)
-            local_store_high_water_ = std::max<uint64_t>(local_store_high_water_,
-                                                         trax::map::kLocalTop - tp.lowest_local);
-    return cycles_;
+    finished_ = finished_ || drained();
+    collect();
+    return finished_;
+}
+
+uint32_t Chip::running_threads() const {
+    uint32_t running = 0;
+    for (const auto& tm : tms_) running += tm->running;
+    return running;
 }
 
 // Shared parts, in a fixed order: replies DRAM -> L2 -> L1, then requests L1 -> L2 -> DRAM
@@ -221,13 +325,17 @@ void Chip::tick_shared(uint64_t now) {
     for (Cache& l2 : l2s_)
         while (l2.pop_reply(now, reply)) tms_[reply.request.source]->l1.fill(now, reply.request.addr);
 
+    const uint32_t line_bytes = config_.l2.line_bytes;
     for (auto& tm : tms_) {
         auto& out = tm->l1.outbound();
         Cache& l2 = l2s_[tm->id / config_.chip.tms_per_l2];
         while (!out.empty() && out.front().cycle <= now) {
             MemRequest request = out.front().request;
             request.source = tm->id;
-            if (!accepted(l2.access(now, request))) break;  // retry next cycle, keep FIFO order
+            const CacheOutcome outcome = l2.access(now, request);
+            if (!accepted(outcome)) break;  // retry next cycle, keep FIFO order
+            count_access(l2_traffic_[request.region], outcome,
+                         request.write ? request.bytes : line_bytes, 0);
             out.pop_front();
         }
     }
@@ -237,10 +345,18 @@ void Chip::tick_shared(uint64_t now) {
             MemRequest request = out.front().request;
             request.source = g;
             if (!dram_.enqueue(now, request)) break;
+            l2_traffic_[request.region].moved_bytes += line_bytes;
             out.pop_front();
         }
     }
     dram_.tick(now);
+    for (const MemRequest& served : dram_.served()) {
+        LevelTraffic& t = dram_traffic_[served.region];
+        ++(served.write ? t.writes : t.reads);
+        t.payload_bytes += served.write ? served.bytes : line_bytes;
+        t.moved_bytes += line_bytes;
+    }
+    dram_.served().clear();
     for (auto& tm : tms_) {
         for (const AtomicRequest& a : tm->atomics_out) global_registers_.submit(a);
         tm->atomics_out.clear();
@@ -273,8 +389,15 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
         for (uint64_t bits = part.of(tm.mem_waiting_tps[part.w]); bits != 0; bits &= bits - 1) {
             const auto bit = static_cast<uint32_t>(std::countr_zero(bits));
             const Tm::Tp& tp = tm.tps[part.index(bit)];
-            if (tp.mem_at <= now && accepted(tm.l1.access(now, tp.mem_request)))
-                accessed |= uint64_t{1} << bit;
+            if (tp.mem_at > now) continue;
+            const MemRequest& request = tp.mem_request;
+            const CacheOutcome outcome = tm.l1.access(now, request);
+            if (!accepted(outcome)) continue;
+            accessed |= uint64_t{1} << bit;
+            const uint64_t moved = outcome == CacheOutcome::Miss ? tm.l1.config().line_bytes
+                                   : request.write                ? request.bytes
+                                                                  : 0;
+            count_access(tm.l1_traffic[request.region], outcome, request.bytes, moved);
         }
         tm.mem_waiting_tps[part.w] &= ~part.back(accessed);
     });
@@ -396,11 +519,13 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             } else if (s.mem_bytes != 0 && is_local(s.mem_address)) {
                 tp.lowest_local = std::min(tp.lowest_local, s.mem_address);
                 ++(s.mem_store ? counters.local_stores : counters.local_loads);
+                counters.local_payload_bytes += s.mem_bytes;
                 result_at = ready + config_.tp.local_store_latency;
             } else if (s.mem_bytes != 0) {
                 set_bit(tm.mem_waiting_tps, i);
                 tp.mem_at = ready;
-                tp.mem_request = {s.mem_address, i, d.rd, s.mem_store};
+                tp.mem_request = {s.mem_address, i,     d.rd, s.mem_store, region_of(s.mem_address),
+                                  s.mem_bytes,   s.pc};
                 result_at = kNever;  // set by the L1 reply
             }
             if (d.rd != isa::kNoReg && !s.mem_store) {
@@ -529,6 +654,41 @@ void Chip::register_stats(stats::Registry& r) const {
                   "achieved DRAM bandwidth at chip.clock_mhz", "GB/s");
     r.add_counter("chip/local_store_high_water", local_store_high_water_,
                   "largest local-store (stack) footprint of any thread", "B");
+
+    // Traffic by region (docs/statistics.md says how each figure is counted).
+    for (size_t region = 0; region <= layout_.regions.size(); ++region) {
+        const std::string& name =
+            region < layout_.regions.size() ? layout_.regions[region].name : "other";
+        const auto add = [&](std::string_view level, const LevelTraffic& t, bool cache) {
+            const std::string p = fmt::format("region/{}/{}/", name, level);
+            r.add_counter(p + "reads", t.reads, cache ? "loads accepted" : "line reads served",
+                          "accesses");
+            r.add_counter(p + "writes", t.writes,
+                          cache ? "stores accepted" : "line writes served", "accesses");
+            if (cache) {
+                r.add_counter(p + "hits", t.hits, "loads that hit", "accesses");
+                r.add_counter(p + "misses", t.misses, "loads that requested a line below",
+                              "accesses");
+                r.add_counter(p + "merged_misses", t.merged_misses,
+                              "loads merged into an outstanding miss", "accesses");
+            }
+            r.add_counter(p + "payload_bytes", t.payload_bytes,
+                          "bytes the kernel's loads and stores asked of this level", "B");
+            r.add_counter(p + "moved_bytes", t.moved_bytes,
+                          "bytes this level moved to or from the level below", "B");
+        };
+        add("l1", l1_traffic_[region], true);
+        add("l2", l2_traffic_[region], true);
+        add("dram", dram_traffic_[region], false);
+    }
+    r.add_sum("region/local_store/local_store/loads", "*/local_store/loads",
+              "loads served by the local stores", "accesses");
+    r.add_sum("region/local_store/local_store/stores", "*/local_store/stores",
+              "stores served by the local stores", "accesses");
+    r.add_counter("region/local_store/local_store/payload_bytes", local_payload_bytes_,
+                  "bytes of those loads and stores", "B");
+    r.add_sum("region/instruction_fetch/icache/fetches", "*/icache/fetches",
+              "instructions fetched, all TMs", "instructions");
 }
 
 }  // namespace tpsim::timing

@@ -11,6 +11,7 @@
 #include "isa/isa.hpp"
 #include "sim/core/machine.hpp"
 #include "stats/registry.hpp"
+#include "timing/attribution.hpp"
 #include "timing/cache.hpp"
 #include "timing/config.hpp"
 #include "timing/dram.hpp"
@@ -20,7 +21,6 @@
 #include <array>
 #include <cstdint>
 #include <deque>
-#include <functional>
 #include <memory>
 #include <vector>
 
@@ -40,48 +40,63 @@ public:
     virtual void step(uint32_t thread, StepInfo& out) = 0;
 };
 
-/// Why a TP did not issue in a cycle (exactly one cause per TP-cycle).
-enum class Stall : uint8_t {
-    FetchConflict,  ///< lost the I-cache bank to another thread
-    Branch,         ///< bubble after a branch (tp.branch_*_penalty)
-    FuBusy,         ///< operands ready but every unit of the pool was taken
-    MemoryPort,     ///< a previous load/store still waits for an L1 bank or MSHR
-    Operand,        ///< an operand is not ready; attributed to its producing pool below
-    Count
-};
+class MachineSource;  // machine_source.hpp
 
 class Chip {
 public:
-    Chip(const ChipConfig& config, InstructionSource& source);
+    /// Any instruction source (e.g. a test's scripted one), called through its virtuals.
+    /// `layout` names the memory regions traffic is counted by (none: all is "other").
+    /// Throws std::invalid_argument for overlapping, unnamed or reserved regions.
+    Chip(const ChipConfig& config, InstructionSource& source, const ChipLayout& layout = {});
+    /// The functional machine: its calls inline into the cycle loop, and its cycle CSRs read
+    /// this chip's clock while the chip lives.
+    Chip(const ChipConfig& config, MachineSource& source, const ChipLayout& layout = {});
     ~Chip();
 
-    /// Called by run() every kProgressInterval cycles with the cycle count, e.g. for a progress
-    /// display; it must not touch the chip or its source.
-    using ProgressHook = std::function<void(uint64_t cycles)>;
+    /// How often callers looping over run_until() usually report progress.
     static constexpr uint64_t kProgressInterval = 1 << 16;
 
-    /// Runs until every thread has exited and all memory traffic has drained; returns the
-    /// cycle count. Throws std::runtime_error if nothing progresses for a long time (deadlock)
-    /// or `max_cycles` pass.
-    uint64_t run(uint64_t max_cycles = UINT64_MAX, const ProgressHook& on_progress = {});
+    /// Runs cycles until `cycle` (exclusive) or until the chip has finished (every thread
+    /// exited, all memory traffic drained); returns finished(). Calls continue where the last
+    /// one stopped, so a run can pause and resume at any cycle with the same result. Throws
+    /// std::runtime_error if nothing issues or returns for a long time (deadlock).
+    bool run_until(uint64_t cycle);
+    bool finished() const { return finished_; }
+    /// Runs to the end; returns the cycle count. Throws std::runtime_error on a deadlock or if
+    /// the chip has not finished by cycle `max_cycles`.
+    uint64_t run(uint64_t max_cycles = UINT64_MAX);
 
     uint64_t cycles() const { return cycles_; }
+    /// Threads that have not exited yet.
+    uint32_t running_threads() const;
+    const ChipLayout& layout() const { return layout_; }
     /// Registers every counter under tm<i>/..., l2/<j>/..., dram/..., global_registers/...,
-    /// and chip-wide sums under chip/... . The chip and `registry` must outlive the printing.
+    /// chip-wide sums under chip/... and traffic by region under region/... . The chip and
+    /// `registry` must outlive the printing.
     void register_stats(stats::Registry& registry) const;
 
 private:
     struct Tm;
     // The cycle loop is instantiated for the concrete MachineSource (its calls inline) and for
-    // any other InstructionSource (tests' scripted sources).
+    // any other InstructionSource (tests' scripted sources); the constructor picks one.
     template <class Source>
-    uint64_t run_with(Source& source, uint64_t max_cycles, const ProgressHook& on_progress);
+    bool run_cycles(uint64_t end);
+    bool busy() const;  // anything in flight except lines in write-combining buffers
+    bool drained() const;
+    /// Index of the region holding `addr` in layout_.regions, or other_region_.
+    uint8_t region_of(uint32_t addr) const;
+    /// The per-TM totals summed chip-wide (and the local-store high-water mark), once per
+    /// run_until() call.
+    void collect();
     void tick_shared(uint64_t now);
     template <class Source, uint32_t kWords>  // kWords: words per TP bit set, 0 = any
     void tick_tm(Tm& tm, uint64_t now, Source& source);
 
     ChipConfig config_;
+    ChipLayout layout_;
     InstructionSource& source_;
+    bool (Chip::*run_cycles_)(uint64_t end) = &Chip::run_cycles<InstructionSource>;
+    core::Machine* clocked_machine_ = nullptr;  // reads cycles_ through its cycle CSRs
     std::vector<std::unique_ptr<Tm>> tms_;
     std::vector<Cache> l2s_;
     Dram dram_;
@@ -90,7 +105,19 @@ private:
     std::array<uint32_t, size_t(Pool::Count)> latency_of_{};
     uint64_t cycles_ = 0;
     uint64_t progress_ = 0;  // bumped whenever anything issues or returns
+    uint64_t last_progress_ = 0, last_progress_cycle_ = 0;  // for the deadlock detector
+    bool finished_ = false;
     uint64_t local_store_high_water_ = 0;  // bytes, max over threads
+    // Region lookup: the regions sorted by address, as [begin, end) and their layout index.
+    struct RegionBounds {
+        uint32_t begin, end;
+        uint8_t index;
+    };
+    std::vector<RegionBounds> region_bounds_;
+    uint8_t other_region_ = 0;  // index of "other": layout_.regions.size()
+    // Traffic by region (index as MemRequest::region); l1_traffic_ sums the TMs' in collect().
+    std::vector<LevelTraffic> l1_traffic_, l2_traffic_, dram_traffic_;
+    uint64_t local_payload_bytes_ = 0;  // summed in collect()
 };
 
 }  // namespace tpsim::timing

@@ -57,6 +57,7 @@ void for_each_field(Config& c, Visit&& visit) {
     };
     cache("l1", c.l1);
     cache("l2", c.l2);
+    visit("l2.write_combining_lines", c.l2.write_combining_lines, Range{0, 4096});
     visit("dram.channels", c.dram.channels, Range{1, 256});
     visit("dram.banks", c.dram.banks, Range{1, 256});
     visit("dram.row_bytes", c.dram.row_bytes, Range{64, 1u << 20});
@@ -276,13 +277,12 @@ std::string to_toml(const ChipConfig& config) {
     return out;
 }
 
-std::vector<std::string> config_keys() {
-    std::vector<std::string> keys;
-    const ChipConfig defaults;
-    for_each_field(defaults, [&](std::string_view name, const auto&, Range) {
-        keys.emplace_back(name);
+std::vector<ConfigField> config_fields(const ChipConfig& config) {
+    std::vector<ConfigField> fields;
+    for_each_field(config, [&](std::string_view name, const auto& field, Range) {
+        fields.push_back({std::string(name), uint32_t(field), kIsBool<decltype(field)>});
     });
-    return keys;
+    return fields;
 }
 
 }  // namespace tpsim::timing

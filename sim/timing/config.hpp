@@ -77,6 +77,16 @@ struct CacheConfig {
     bool operator==(const CacheConfig&) const = default;
 };
 
+/// [l2] The L2 adds a store policy to the cache above (docs/hardware-model.md).
+struct L2Config : CacheConfig {
+    /// 0: write-around (TRaX), every store goes to DRAM as one line write. N > 0: a buffer of
+    /// N lines per L2 merges stores to a line; a line goes to DRAM as one write when all its
+    /// bytes are written, when it is the oldest and a new line needs room, before a load miss
+    /// to it, or at the end of the run.
+    uint32_t write_combining_lines = 0;
+    bool operator==(const L2Config&) const = default;
+};
+
 /// [dram] Channels x banks with row buffers (open-page, FR-FCFS). All times are in core cycles
 /// (a GDDR part at 2x the core clock has half its own cycle counts).
 struct DramConfig {
@@ -113,7 +123,7 @@ struct ChipConfig {
     FuPoolsConfig fu;
     ICacheConfig icache;
     CacheConfig l1;
-    CacheConfig l2{524288, 8, 64, 16, 8, 64};
+    L2Config l2{{524288, 8, 64, 16, 8, 64}};
     DramConfig dram;
     GlobalRegisterConfig global_registers;
     bool operator==(const ChipConfig&) const = default;
@@ -133,7 +143,13 @@ void apply_override(ChipConfig& config, std::string_view assignment);
 void validate(const ChipConfig& config);
 /// The resolved configuration as TOML, every key present, with its allowed range as a comment.
 std::string to_toml(const ChipConfig& config);
-/// Every configurable key, in print order (for help text and tests).
-std::vector<std::string> config_keys();
+/// One configurable field's resolved value.
+struct ConfigField {
+    std::string key;  ///< e.g. "l1.size_bytes"
+    uint32_t value;   ///< 0 or 1 when is_bool
+    bool is_bool;
+};
+/// Every configurable field of `config`, in print order (statistics file, help text, tests).
+std::vector<ConfigField> config_fields(const ChipConfig& config);
 
 }  // namespace tpsim::timing

@@ -93,10 +93,12 @@ void Dram::serve(Channel& ch, size_t index, uint64_t now) {
     else
         ++counters_.row_hits;
     counters_.bus_busy_cycles += config_.tBURST;
+    served_.push_back(p.request);
     if (p.request.write) {
         ++counters_.writes;
         counters_.bytes_written += line_bytes_;
-        return;  // write-around stores need no reply
+        counters_.store_payload_bytes += p.request.bytes;
+        return;  // stores need no reply
     }
     ++counters_.reads;
     counters_.bytes_read += line_bytes_;
@@ -163,7 +165,10 @@ void Dram::register_stats(stats::Registry& r, std::string_view prefix) const {
     r.add_counter(name("reads"), counters_.reads, "line reads served", "requests");
     r.add_counter(name("writes"), counters_.writes, "line writes served", "requests");
     r.add_counter(name("bytes_read"), counters_.bytes_read, "bytes read", "B");
-    r.add_counter(name("bytes_written"), counters_.bytes_written, "bytes written", "B");
+    r.add_counter(name("bytes_written"), counters_.bytes_written, "bytes written (whole lines)",
+                  "B");
+    r.add_counter(name("store_payload_bytes"), counters_.store_payload_bytes,
+                  "bytes of those line writes that stores wrote", "B");
     r.add_counter(name("row_hits"), counters_.row_hits, "requests served from an open row",
                   "requests");
     r.add_counter(name("row_misses"), counters_.row_misses,

@@ -48,6 +48,7 @@ public:
         uint64_t writes = 0;
         uint64_t bytes_read = 0;
         uint64_t bytes_written = 0;
+        uint64_t store_payload_bytes = 0;  ///< bytes the stores behind the line writes wrote
         uint64_t row_hits = 0;       ///< served from an already open row
         uint64_t row_misses = 0;     ///< needed an activate of a closed bank
         uint64_t row_conflicts = 0;  ///< needed a precharge of another open row, then activate
@@ -70,6 +71,9 @@ public:
     /// Pops the next read reply whose data has fully arrived by `now`, in (ready, issue) order.
     bool pop_reply(uint64_t now, MemReply& reply);
     bool idle() const;
+    /// Every request served (read or write) since the owner last cleared it, in issue order:
+    /// the chip charges their bytes to regions, instructions and work items.
+    std::vector<MemRequest>& served() { return served_; }
 
     const Counters& counters() const { return counters_; }
     void register_stats(stats::Registry& registry, std::string_view prefix) const;
@@ -114,6 +118,7 @@ private:
     std::vector<Channel> channels_;
     std::priority_queue<Reply, std::vector<Reply>, std::greater<>> replies_;
     uint64_t next_sequence_ = 0;
+    std::vector<MemRequest> served_;
     Counters counters_;
 };
 

@@ -150,3 +150,50 @@ TEST_CASE("I-cache banks: a set of threads fetches lowest bit first", "[icache]"
     CHECK(icache.counters().fetches == 2);
     CHECK(icache.counters().conflicts == 2);
 }
+
+TEST_CASE("write-combining merges stores to a line into one line write", "[cache]") {
+    Cache cache(kSmall, 2);  // two lines of 64 B
+    const auto store_of = [](uint32_t addr, uint16_t bytes) {
+        MemRequest s = store(addr);
+        s.bytes = bytes;
+        return s;
+    };
+    uint64_t now = 0;
+    // Line 0x000 written in 16 word stores (alternating banks keep them one per cycle): only
+    // the last one sends it on, as one write of all 64 bytes.
+    for (uint32_t b = 0; b < 64; b += 4) {
+        CHECK(cache.outbound().empty());
+        REQUIRE(cache.access(now++, store_of(b, 4)) == CacheOutcome::WriteCombined);
+    }
+    REQUIRE(cache.outbound().size() == 1);
+    CHECK(cache.outbound().front().request.addr == 0x000);
+    CHECK(cache.outbound().front().request.bytes == 64);
+    CHECK(cache.outbound().front().request.write);
+    cache.outbound().clear();
+    // Rewriting bytes adds none; a third line evicts the oldest, partly written one.
+    REQUIRE(cache.access(now++, store_of(0x100, 4)) == CacheOutcome::WriteCombined);
+    REQUIRE(cache.access(now++, store_of(0x100, 4)) == CacheOutcome::WriteCombined);
+    REQUIRE(cache.access(now++, store_of(0x248, 8)) == CacheOutcome::WriteCombined);
+    CHECK(cache.outbound().empty());
+    REQUIRE(cache.access(now++, store_of(0x3c0, 2)) == CacheOutcome::WriteCombined);
+    REQUIRE(cache.outbound().size() == 1);
+    CHECK(cache.outbound().front().request.addr == 0x100);
+    CHECK(cache.outbound().front().request.bytes == 4);
+    cache.outbound().clear();
+    // A load miss to a buffered line sends the line's stores on before the line request.
+    REQUIRE(cache.access(now++, load(0x240)) == CacheOutcome::Miss);
+    REQUIRE(cache.outbound().size() == 2);
+    CHECK(cache.outbound()[0].request.write);
+    CHECK(cache.outbound()[0].request.addr == 0x240);
+    CHECK(cache.outbound()[0].request.bytes == 8);
+    CHECK_FALSE(cache.outbound()[1].request.write);
+    cache.outbound().clear();
+    // The end of the run drains what is left.
+    CHECK(cache.holds_combined_lines());
+    CHECK(cache.drain_write_buffer(now));
+    REQUIRE(cache.outbound().size() == 1);
+    CHECK(cache.outbound().front().request.addr == 0x3c0);
+    CHECK(cache.outbound().front().request.bytes == 2);
+    CHECK_FALSE(cache.holds_combined_lines());
+    CHECK_FALSE(cache.drain_write_buffer(now));
+}

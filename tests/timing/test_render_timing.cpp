@@ -91,6 +91,7 @@ TEST_CASE("timing parameters never change the image", "[render][invariance]") {
         {"dram.tCL=40", "dram.tRP=30"},
         {"fu.fp_mul.count=4", "fu.fp_add.latency=7"},
         {"global_registers.latency=50", "icache.banks=1"},
+        {"l2.write_combining_lines=2", "l2.size_bytes=4096"},
     };
     uint64_t previous_cycles = 0;
     for (const auto& overrides : variants) {
@@ -138,22 +139,29 @@ struct ChipRun {
     std::vector<uint32_t> global;      // global memory afterwards (framebuffer included)
 };
 
+/// Runs the tracer on the 32x32 Cornell box; with `pause_every`, in run_until() steps of that
+/// many cycles.
 template <class Source>
-ChipRun run_chip(const timing::ChipConfig& chip) {
+ChipRun run_chip(const timing::ChipConfig& chip, uint64_t pause_every = 0) {
     const scene::Scene scene = scene::load_scene(small_cornell());
     scene::BvhConfig bvh_config;
     bvh_config.traversal_stack_entries = trax::layout::kTraversalStackEntries;
     const scene::Bvh bvh = scene::build_bvh(scene.triangles, bvh_config);
     const image::MemoryImage image =
         image::build_memory_image(scene, &bvh, chip.chip.num_tms * chip.chip.tps_per_tm);
-    core::MachineConfig config = timing::machine_config_for(chip);
-    config.global_bytes = uint32_t(image.bytes());
-    config.read_only_global_bytes = uint32_t(image.read_only_bytes());
-    core::Machine machine(core::load_elf(TPSIM_KERNEL_DIR "/tracer.elf"), config);
-    std::memcpy(machine.memory().global().data(), image.words.data(), image.bytes());
+    const auto machine_ptr =
+        timing::make_machine(core::load_elf(TPSIM_KERNEL_DIR "/tracer.elf"), image.words,
+                             image.read_only_bytes(), chip, uint64_t(1) << 32);
+    core::Machine& machine = *machine_ptr;
     Source source(machine);
     timing::Chip model(chip, source);
-    model.run();
+    if (pause_every == 0)
+        model.run();
+    else
+        for (uint64_t until = pause_every; !model.run_until(until); until += pause_every)
+            REQUIRE(model.cycles() == until);
+    CHECK(model.finished());
+    CHECK(model.run_until(model.cycles() + 1));  // a finished chip stays finished
     stats::Registry registry;
     model.register_stats(registry);
     ChipRun run;
@@ -179,5 +187,17 @@ TEST_CASE("running threads ahead through private instructions changes nothing th
         CHECK(ahead.stats == at_fetch.stats);
         CHECK(ahead.global == at_fetch.global);
         CHECK(ahead.stats.find("chip/instructions=0\n") == std::string::npos);
+    }
+}
+
+TEST_CASE("a run paused and resumed at any cycle gives the run without pauses",
+          "[render][determinism]") {
+    const timing::ChipConfig chip = tiny();
+    const ChipRun whole = run_chip<timing::MachineSource>(chip);
+    for (uint64_t pause_every : {1u, 997u, 65536u}) {
+        INFO(pause_every);
+        const ChipRun paused = run_chip<timing::MachineSource>(chip, pause_every);
+        CHECK(paused.stats == whole.stats);
+        CHECK(paused.global == whole.global);
     }
 }
