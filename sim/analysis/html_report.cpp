@@ -71,6 +71,7 @@ struct Chart {
     std::string unit = "";  ///< the value axis title
     bool horizontal = false;
     bool percent = false;
+    bool log = false;  ///< a logarithmic value axis
     bool tall = false;
     Json labels = Json::array();
     Json datasets = Json::array();
@@ -80,15 +81,16 @@ struct Chart {
     }
     bool has_data() const {
         for (const Json& d : datasets)
-            for (const Json& v : d["data"])
-                if ((v.is_object() ? v["y"] : v) != 0) return true;
+            for (const Json& v : d["data"]) {
+                const Json& y = v.is_object() ? v["y"] : v;
+                if (y.is_number() && y != 0) return true;
+            }
         return false;
     }
     Json to_json() const {
-        return {{"type", type},        {"title", title},
-                {"unit", unit},        {"horizontal", horizontal},
-                {"percent", percent},  {"labels", labels},
-                {"datasets", datasets}};
+        return {
+            {"type", type},       {"title", title}, {"unit", unit},     {"horizontal", horizontal},
+            {"percent", percent}, {"log", log},     {"labels", labels}, {"datasets", datasets}};
     }
 };
 
@@ -262,52 +264,70 @@ void cycles_charts(Page& page, const StatsFile& run) {
 void traffic(Page& page, const StatsFile& run) {
     const auto regions = region_levels(run);
     if (regions.empty()) return;
+    const auto stat = [&](const std::string& region, const std::string& level, const char* leaf) {
+        return run.stat("region/" + region + "/" + level + "/" + leaf);
+    };
+    const auto moves_bytes = [&](const std::string& region, const std::string& level) {
+        return stat(region, level, "moved_bytes").value_or(0) != 0;
+    };
+    // The chart: the levels that move bytes (l1, l2, dram), on a log scale, as the regions'
+    // traffic spans orders of magnitude.
     std::vector<std::string> levels;
     for (const auto& [region, own_levels] : regions)
         for (const std::string& level : own_levels)
-            if (std::find(levels.begin(), levels.end(), level) == levels.end())
+            if (moves_bytes(region, level) &&
+                std::find(levels.begin(), levels.end(), level) == levels.end())
                 levels.push_back(level);
-    Chart chart{.title = "Bytes moved by region and level", .unit = "B", .tall = true};
+    Chart chart{.title = "Bytes moved by region and level (log scale)",
+                .unit = "B",
+                .log = true,
+                .tall = true};
     std::vector<Json> data(levels.size(), Json::array());
+    for (const auto& [region, own_levels] : regions) {
+        if (std::none_of(levels.begin(), levels.end(),
+                         [&](const std::string& level) { return moves_bytes(region, level); }))
+            continue;
+        chart.labels.push_back(region);
+        for (size_t l = 0; l < levels.size(); ++l) {
+            const double bytes = stat(region, levels[l], "moved_bytes").value_or(0);
+            data[l].push_back(bytes > 0 ? Json(bytes) : Json());  // no bar rather than log(0)
+        }
+    }
+    for (size_t l = 0; l < levels.size(); ++l)
+        chart.add(levels[l], data[l]);
+
+    // The table: every region x level that saw an access; local-store loads and stores and
+    // I-cache fetches go in the reads and writes columns.
     std::ostringstream table;
     table << "<table><tr><th>region</th><th>level</th><th class=\"num\">reads</th>"
              "<th class=\"num\">writes</th><th class=\"num\">misses</th>"
              "<th class=\"num\">hit rate</th><th class=\"num\">payload B</th>"
              "<th class=\"num\">moved B</th></tr>\n";
-    for (const auto& [region, own_levels] : regions) {
-        bool any = false;
-        for (const std::string& level : levels)
-            any |= run.stat("region/" + region + "/" + level + "/moved_bytes").value_or(0) != 0;
-        if (any) {
-            chart.labels.push_back(region);
-            for (size_t l = 0; l < levels.size(); ++l)
-                data[l].push_back(
-                    run.stat("region/" + region + "/" + levels[l] + "/moved_bytes").value_or(0));
-        }
+    for (const auto& [region, own_levels] : regions)
         for (const std::string& level : own_levels) {
-            const std::string prefix = "region/" + region + "/" + level + "/";
-            const auto cell = [&](const char* leaf) {
-                const auto v = run.stat(prefix + leaf);
-                return v ? readable(*v) : std::string();
+            const auto first_of = [&](std::initializer_list<const char*> leaves) {
+                for (const char* leaf : leaves)
+                    if (const auto v = stat(region, level, leaf)) return v;
+                return std::optional<double>();
             };
-            const auto reads = run.stat(prefix + "reads"), hits = run.stat(prefix + "hits");
-            if (run.stat(prefix + "reads").value_or(0) == 0 &&
-                run.stat(prefix + "writes").value_or(0) == 0 &&
-                run.stat(prefix + "moved_bytes").value_or(0) == 0)
+            const auto reads = first_of({"reads", "loads", "fetches"});
+            const auto writes = first_of({"writes", "stores"});
+            const auto misses = stat(region, level, "misses"), hits = stat(region, level, "hits");
+            const auto payload = stat(region, level, "payload_bytes");
+            const auto moved = stat(region, level, "moved_bytes");
+            if (reads.value_or(0) == 0 && writes.value_or(0) == 0 && payload.value_or(0) == 0 &&
+                moved.value_or(0) == 0)
                 continue;
-            table << fmt::format(
-                "<tr><td>{}</td><td>{}</td><td class=\"num\">{}</td><td "
-                "class=\"num\">{}</td><td class=\"num\">{}</td><td "
-                "class=\"num\">{}</td><td class=\"num\">{}</td><td "
-                "class=\"num\">{}</td></tr>\n",
-                escape(region), escape(level), cell("reads"), cell("writes"), cell("misses"),
-                reads && hits && *reads > 0 ? fmt::format("{:.1f} %", 100 * *hits / *reads) : "",
-                cell("payload_bytes"), cell("moved_bytes"));
+            const auto cell = [](std::optional<double> v) {
+                return fmt::format("<td class=\"num\">{}</td>", v ? readable(*v) : "");
+            };
+            table << "<tr><td>" << escape(region) << "</td><td>" << escape(level) << "</td>"
+                  << cell(reads) << cell(writes) << cell(misses) << "<td class=\"num\">"
+                  << (reads && hits && *reads > 0 ? fmt::format("{:.1f} %", 100 * *hits / *reads)
+                                                  : "")
+                  << "</td>" << cell(payload) << cell(moved) << "</tr>\n";
         }
-    }
     table << "</table>\n";
-    for (size_t l = 0; l < levels.size(); ++l)
-        chart.add(levels[l], data[l]);
     page.body << "<h2>Memory traffic by region</h2>\n";
     page.chart(chart);
     page.body << table.str();

@@ -23,16 +23,23 @@
         return matching >= 20;
     }
     function nonzero(dataset) {
-        return dataset.data.some(function (v) { return (typeof v === 'object' ? v.y : v) !== 0; });
+        return dataset.data.some(function (v) {
+            const y = v !== null && typeof v === 'object' ? v.y : v;
+            return y !== null && y !== 0;
+        });
     }
     function options(spec) {
         const valueAxis = {
-            beginAtZero: true,
+            type: spec.log ? 'logarithmic' : 'linear',
+            beginAtZero: !spec.log,
             title: { display: !!spec.unit, text: spec.unit },
             ticks: spec.percent ? { callback: function (v) { return v + ' %'; } } : {}
         };
+        // Timelines span exactly cycle 0 to the last sample.
+        const lastCycle = spec.type === 'line'
+            ? Math.max.apply(null, spec.datasets[0].data.map(function (p) { return p.x; })) : 0;
         const categoryAxis = spec.type === 'line'
-            ? { type: 'linear', min: 0, title: { display: true, text: 'cycle' } }
+            ? { type: 'linear', min: 0, max: lastCycle, title: { display: true, text: 'cycle' } }
             : { ticks: { autoSkip: false } };
         return {
             animation: false,
