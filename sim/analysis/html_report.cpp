@@ -608,7 +608,12 @@ std::string comparison_page(const std::vector<StatsFile>& runs, const Comparison
         Section dram{"dram", {}};
         for (const Row& row : s->rows)
             if (row.key.ends_with("/dram/moved_bytes")) dram.rows.push_back(row);
-        page.chart(grouped(c, dram, "DRAM bytes moved by region", false));
+        Chart chart = grouped(c, dram, "DRAM bytes moved by region (log scale)", false);
+        chart.log = true;
+        for (Json& dataset : chart.datasets)  // no bar rather than log(0)
+            for (Json& bytes : dataset["data"])
+                if (bytes == 0) bytes = Json();
+        page.chart(chart);
     }
     page.body << "</div>\n";
     for (const Section& section : c.sections) {

@@ -41,19 +41,19 @@ int run_compare(const CompareCommandOptions& o) {
                                     : o.format == "csv"    ? analysis::Format::csv
                                     : o.format == "json"   ? analysis::Format::json
                                                            : analysis::Format::text;
-    const std::string chart_js = o.html.empty() ? "" : analysis::load_chart_js();
-    if (o.output.empty()) {
-        // Colour only for a person at a terminal, never in a file or pipe.
-        analysis::write_comparison(comparison, format, std::cout,
-                                   format == analysis::Format::text && isatty(STDOUT_FILENO));
-    } else {
+    // Files first: a reader that closes standard output early (| head) must not cost them.
+    if (!o.html.empty())
+        write_output(o.html, analysis::comparison_page(runs, comparison, analysis::load_chart_js()),
+                     "the HTML comparison");
+    if (!o.output.empty()) {
         std::ostringstream text;
         analysis::write_comparison(comparison, format, text);
         write_output(o.output, text.str(), "the comparison");
+    } else {
+        // Colour only for a person at a terminal, never in a file or pipe.
+        analysis::write_comparison(comparison, format, std::cout,
+                                   format == analysis::Format::text && isatty(STDOUT_FILENO));
     }
-    if (!o.html.empty())
-        write_output(o.html, analysis::comparison_page(runs, comparison, chart_js),
-                     "the HTML comparison");
     return 0;
 }
 
