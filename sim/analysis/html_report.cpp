@@ -42,7 +42,7 @@ std::string escape(std::string_view text) {
     return out;
 }
 
-/// A number with a unit, shortened for a card: 2.232 ms, 54.2 M, 189.9 M.
+/// A number shortened for a summary card: 2.23 M, 121 k, 0.6648.
 std::string short_number(double value) {
     const double magnitude = std::abs(value);
     if (magnitude >= 1e9) return fmt::format("{:.3g} G", value / 1e9);
