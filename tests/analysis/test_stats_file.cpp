@@ -7,6 +7,7 @@
 
 #include "sim/analysis/stats_file.hpp"
 #include "sim/core/error.hpp"
+#include "sim/render/profile.hpp"
 
 using namespace tpsim;
 using namespace tpsim::analysis;
@@ -143,4 +144,39 @@ TEST_CASE("stats file: missing, directory and oversized files are named", "[anal
                                            "the 256 MiB this tpsim reads; give a file written by "
                                            "tpsim render --stats-json");
     std::filesystem::remove(huge);
+}
+
+TEST_CASE("stats file: the profile the renderer writes reads back field for field", "[analysis]") {
+    render::Profile written;
+    written.total = {.executions = 10,
+                     .cycles = 30,
+                     .stalls = {1, 2, 3, 4, 10},
+                     .l1_misses = 5,
+                     .dram_bytes = 640};
+    written.functions.push_back({"trax_main", 0x100, written.total});
+    written.lines.push_back({"tracer.cpp", "/src/tracer.cpp", 42, "trax_main", written.total});
+    Json doc = {{"format", "tpsim-stats"},
+                {"version", 2},
+                {"run", Json::object()},
+                {"stats", Json::object()}};
+    doc["profile"] = render::profile_json(written);
+    const StatsFile f = parse_stats_file(doc.dump(), "x.json");
+    REQUIRE(f.profile);
+    CHECK(f.profile->total_cycles == 30);
+    REQUIRE(f.profile->functions.size() == 1);
+    REQUIRE(f.profile->lines.size() == 1);
+    for (const ProfileEntry* e : {&f.profile->functions[0], &f.profile->lines[0]}) {
+        CHECK(e->function == "trax_main");
+        CHECK(e->executions == 10);
+        CHECK(e->cycles == 30);
+        CHECK(e->l1_misses == 5);
+        CHECK(e->dram_bytes == 640);
+        REQUIRE(e->stalls.size() == render::kStallNames.size());
+        for (size_t cause = 0; cause < e->stalls.size(); ++cause) {
+            CHECK(e->stalls[cause].first == render::kStallNames[cause]);
+            CHECK(e->stalls[cause].second == written.total.stalls[cause]);
+        }
+    }
+    CHECK(f.profile->lines[0].file == "tracer.cpp");
+    CHECK(f.profile->lines[0].line == 42);
 }
