@@ -132,6 +132,7 @@ int run_render(const RenderCommandOptions& o) {
     stats::Registry registry;
     render::register_stats(result, registry);
     const stats::Snapshot snapshot(registry);
+    render::print_traffic(snapshot, options.chip.l2.line_bytes, std::cout);
     if (o.verbose) {
         fmt::print("\n# chip configuration (resolved)\n{}\n", timing::to_toml(options.chip));
         stats::print_text(snapshot, std::cout);
