@@ -34,9 +34,13 @@ std::string bytes_text(double bytes) {
 
 /// "12,345,678": a count with thousands separators.
 std::string count_text(double count) {
-    std::string digits = fmt::format("{}", uint64_t(count));
-    for (size_t i = digits.size(); i > 3; i -= 3) digits.insert(i - 3, ",");
-    return digits;
+    const std::string digits = fmt::format("{}", uint64_t(count));
+    std::string grouped;
+    for (size_t i = 0; i < digits.size(); ++i) {
+        if (i > 0 && (digits.size() - i) % 3 == 0) grouped += ',';
+        grouped += digits[i];
+    }
+    return grouped;
 }
 
 std::string percent_text(double numerator, double denominator) {
