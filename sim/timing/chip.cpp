@@ -64,6 +64,11 @@ struct Chip::Tm {
         uint64_t mem_at = 0;         // a granted load/store's first cycle at the L1
         MemRequest mem_request;
         uint32_t lowest_local = trax::map::kLocalTop;  // for the local-store high-water mark
+        // The work item held (the last atomicinc(0) result; none before the first), since
+        // which cycle, and the instructions issued for it since then (Chip::work_items).
+        uint32_t item = UINT32_MAX;
+        uint64_t item_since = 0;
+        uint64_t item_instructions = 0;
         // Cycle each register becomes readable; the extra last slot is isa::kNoReg (an unused
         // operand) and stays 0, so the scoreboard check needs no branch per operand.
         std::array<uint64_t, isa::kNumRegs + 1> reg_ready{};
@@ -192,6 +197,7 @@ Chip::Chip(const ChipConfig& config, InstructionSource& source, const ChipLayout
                 layout.regions[region_bounds_[r - 1].index].name,
                 layout.regions[region_bounds_[r].index].name));
     other_region_ = uint8_t(layout.regions.size());
+    work_items_.items.resize(layout.work_items);
     const size_t regions = layout.regions.size() + 1;
     l1_traffic_.resize(regions);
     l2_traffic_.resize(regions);
@@ -349,6 +355,7 @@ void Chip::tick_shared(uint64_t now) {
         ++(served.write ? t.writes : t.reads);
         t.payload_bytes += served.write ? served.bytes : line_bytes;
         t.moved_bytes += line_bytes;
+        item_costs(served.item).dram_bytes += line_bytes;
     }
     dram_.served().clear();
     for (auto& tm : tms_) {
@@ -506,6 +513,14 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             const Pool pool = tp.pending_pool;
             const uint64_t ready = now + latency_of_[size_t(pool)];
             ++counters.per_class[size_t(fu)];
+            // atomicinc(0) hands out the next work item; it is the first instruction of it.
+            if (fu == isa::FuClass::Atomic && d.imm == 0) [[unlikely]] {
+                charge_item(tp.item, now - tp.item_since, tp.item_instructions);
+                tp.item = s.atomic_result;
+                tp.item_since = now;
+                tp.item_instructions = 0;
+            }
+            ++tp.item_instructions;
             uint64_t result_at = ready;
             if (fu == isa::FuClass::Atomic) {
                 result_at = kNever;  // set by the global-register reply
@@ -518,8 +533,8 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             } else if (s.mem_bytes != 0) {
                 set_bit(tm.mem_waiting_tps, i);
                 tp.mem_at = ready;
-                tp.mem_request = {s.mem_address, i,     d.rd, s.mem_store, region_of(s.mem_address),
-                                  s.mem_bytes,   s.pc};
+                tp.mem_request = {s.mem_address, i,     d.rd,   s.mem_store, region_of(s.mem_address),
+                                  s.mem_bytes,   s.pc, tp.item};
                 result_at = kNever;  // set by the L1 reply
             }
             if (d.rd != isa::kNoReg && !s.mem_store) {
@@ -529,6 +544,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             if (s.exited) {
                 clear_bit(tm.awake_tps, i);
                 --tm.running;
+                charge_item(tp.item, now + 1 - tp.item_since, tp.item_instructions);
             } else if (fu == isa::FuClass::Branch) {
                 // The bubble after a branch: no fetch before now + 1 + bubble.
                 const uint32_t bubble = s.taken ? config_.tp.branch_taken_penalty

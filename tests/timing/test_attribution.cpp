@@ -187,3 +187,55 @@ TEST_CASE("write-combining writes a framebuffer to DRAM once per line, write-aro
             REQUIRE(word == p + k);
         }
 }
+
+namespace {
+
+WorkItemCounters sum(const WorkItemCosts& costs) {
+    WorkItemCounters total = costs.unassigned;
+    for (const WorkItemCounters& item : costs.items) {
+        total.cycles += item.cycles;
+        total.instructions += item.instructions;
+        total.dram_bytes += item.dram_bytes;
+    }
+    return total;
+}
+
+/// Items plus unassigned hold every instruction, every DRAM byte and every TP-cycle of every
+/// thread until it exited.
+void check_work_item_totals(const Chip& chip) {
+    const Stats s(chip);
+    const WorkItemCounters total = sum(chip.work_items());
+    CHECK(total.instructions == s("chip/instructions"));
+    CHECK(total.dram_bytes == s("dram/bytes_read") + s("dram/bytes_written"));
+    CHECK(total.cycles == s("chip/active_tp_cycles"));
+    CHECK(chip.work_items().unassigned.instructions > 0); // startup and the fetch past the end
+}
+
+} // namespace
+
+TEST_CASE("costs by work item add up to the chip's totals", "[attribution][work_items]") {
+    for (const ChipConfig& chip : {ChipConfig{}, tiny(), odd_chip()}) {
+        const render::RenderResult result = render_on(chip, TPSIM_SCENE_DIR "/cornell.toml", 32);
+        const WorkItemCosts& costs = result.timing->chip->work_items();
+        REQUIRE(costs.items.size() == 32 * 32);
+        check_work_item_totals(*result.timing->chip);
+        for (const WorkItemCounters& item : costs.items) {
+            REQUIRE(item.instructions > 0);
+            REQUIRE(item.cycles >= item.instructions);
+        }
+    }
+}
+
+TEST_CASE("each framebuffer pixel costs its 12 instructions and, with write-around, its three "
+          "line writes",
+          "[attribution][work_items]") {
+    const FramebufferRun run(tiny());
+    const WorkItemCosts& costs = run.chip->work_items();
+    REQUIRE(costs.items.size() == kPixels);
+    check_work_item_totals(*run.chip);
+    for (const WorkItemCounters& item : costs.items) {
+        REQUIRE(item.instructions == 12); // atominc, bge, 6 address and value ops, 3 sw, j
+        REQUIRE(item.dram_bytes == 3 * 64);
+    }
+    CHECK(costs.unassigned.dram_bytes == 0);
+}
