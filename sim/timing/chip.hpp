@@ -72,6 +72,9 @@ public:
     /// held (docs/statistics.md, "Work items"). Complete once the chip has finished; while
     /// paused, an item still in progress is not charged yet.
     const WorkItemCosts& work_items() const { return work_items_; }
+    /// Costs by instruction address (docs/statistics.md, "Profile"); empty unless
+    /// ChipLayout::profile. Complete once finished, as work_items().
+    const PcProfile& profile() const { return profile_; }
     /// Registers every counter under tm<i>/..., l2/<j>/..., dram/..., global_registers/...,
     /// chip-wide sums under chip/... and traffic by region under region/... . The chip and
     /// `registry` must outlive the printing.
@@ -99,7 +102,8 @@ private:
         costs.instructions += instructions;
     }
     void tick_shared(uint64_t now);
-    template <class Source, uint32_t kWords>  // kWords: words per TP bit set, 0 = any
+    // kWords: words per TP bit set, 0 = any; kProfile: collect the PcProfile.
+    template <class Source, uint32_t kWords, bool kProfile>
     void tick_tm(Tm& tm, uint64_t now, Source& source);
 
     ChipConfig config_;
@@ -129,6 +133,8 @@ private:
     std::vector<LevelTraffic> l1_traffic_, l2_traffic_, dram_traffic_;
     uint64_t local_payload_bytes_ = 0;  // summed in collect()
     WorkItemCosts work_items_;
+    PcProfile profile_;
+    PcCounters outside_text_;  // takes the profile's share of a pc about to fault; never read
 };
 
 }  // namespace tpsim::timing

@@ -4,6 +4,8 @@
 #include "sim/core/elf_loader.hpp"
 #include "sim/render/render.hpp"
 #include "sim/render/timing_run.hpp"
+#include "sim/scene/bvh.hpp"
+#include "sim/scene/load_scene.hpp"
 #include "timing/machine_source.hpp"
 
 #include <catch2/catch.hpp>
@@ -238,4 +240,67 @@ TEST_CASE("each framebuffer pixel costs its 12 instructions and, with write-arou
         REQUIRE(item.dram_bytes == 3 * 64);
     }
     CHECK(costs.unassigned.dram_bytes == 0);
+}
+
+namespace {
+
+/// The tracer on the 32x32 Cornell box with the profile on.
+struct ProfiledRun {
+    explicit ProfiledRun(const ChipConfig& config) {
+        scene::Scene scene = scene::load_scene(TPSIM_SCENE_DIR "/cornell.toml");
+        scene.width = scene.height = 32;
+        scene::BvhConfig bvh_config;
+        bvh_config.traversal_stack_entries = trax::layout::kTraversalStackEntries;
+        const scene::Bvh bvh = scene::build_bvh(scene.triangles, bvh_config);
+        image =
+            image::build_memory_image(scene, &bvh, config.chip.num_tms * config.chip.tps_per_tm);
+        core::MachineConfig machine_config = machine_config_for(config);
+        machine_config.global_bytes = uint32_t(image.bytes());
+        machine_config.read_only_global_bytes = uint32_t(image.read_only_bytes());
+        machine = std::make_unique<core::Machine>(core::load_elf(TPSIM_KERNEL_DIR "/tracer.elf"),
+                                                  machine_config);
+        std::memcpy(machine->memory().global().data(), image.words.data(), image.bytes());
+        source = std::make_unique<MachineSource>(*machine);
+        ChipLayout layout = render::chip_layout(image, *machine);
+        layout.profile = true;
+        chip = std::make_unique<Chip>(config, *source, layout);
+        chip->run();
+    }
+    image::MemoryImage image;
+    std::unique_ptr<core::Machine> machine;
+    std::unique_ptr<MachineSource> source;
+    std::unique_ptr<Chip> chip;
+};
+
+} // namespace
+
+TEST_CASE("the profile by instruction adds up to the chip's totals", "[attribution][profile]") {
+    for (const ChipConfig& config : {ChipConfig{}, tiny(), odd_chip()}) {
+        const ProfiledRun run(config);
+        const Chip& chip = *run.chip;
+        const Stats s(chip);
+        const PcProfile& profile = chip.profile();
+        REQUIRE(profile.words.size() == run.machine->text_words());
+        PcCounters total;
+        for (const PcCounters& pc : profile.words) {
+            total.executions += pc.executions;
+            for (size_t c = 0; c < kStallCauses; ++c)
+                total.stalls[c] += pc.stalls[c];
+            total.l1_misses += pc.l1_misses;
+            total.dram_bytes += pc.dram_bytes;
+        }
+        CHECK(total.executions == s("chip/instructions"));
+        const char* causes[] = {"fetch_conflict", "branch", "fu_busy", "memory_port", "operand"};
+        for (size_t c = 0; c < kStallCauses; ++c) {
+            INFO(causes[c]);
+            CHECK(total.stalls[c] == s(fmt::format("chip/stalls/{}", causes[c])));
+            CHECK(total.stalls[c] > 0);
+        }
+        CHECK(total.l1_misses == s("chip/l1/misses"));
+        CHECK(total.dram_bytes == s("dram/bytes_read") + s("dram/bytes_written"));
+        // The same run without the profile: the profile changes nothing else.
+        const render::RenderResult plain = render_on(config, TPSIM_SCENE_DIR "/cornell.toml", 32);
+        CHECK(plain.timing->chip->profile().words.empty());
+        CHECK(Stats(*plain.timing->chip)("chip/cycles") == s("chip/cycles"));
+    }
 }
