@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <fmt/ostream.h>
 
+#include "profile.hpp"
 #include "timing_run.hpp"
 
 namespace tpsim::render {
@@ -272,6 +273,7 @@ nlohmann::ordered_json stats_document(const RenderOptions& options, const Render
     if (const std::vector<std::string> regions = region_names(snapshot); !regions.empty())
         doc["regions"] = regions;
     if (r.timing) doc["timeline"] = r.timing->timeline->json();
+    if (r.profile) doc["profile"] = profile_json(*r.profile);
     return doc;
 }
 
