@@ -13,9 +13,12 @@
 
 #include "commands.hpp"
 #include "sim/core/error.hpp"
+#include "sim/render/heatmap.hpp"
 #include "sim/render/image_file.hpp"
+#include "sim/render/profile.hpp"
 #include "sim/render/render.hpp"
 #include "sim/render/report.hpp"
+#include "sim/render/timing_run.hpp"
 #include "sim/stats/registry.hpp"
 #include "sim/timing/config.hpp"
 
@@ -77,6 +80,15 @@ private:
     Clock::time_point start_, last_;
 };
 
+/// Throws unless the directory `path` would be written into exists.
+void check_directory_of(const std::filesystem::path& path, std::string_view what) {
+    const std::filesystem::path directory =
+        path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+    if (std::error_code ec; !std::filesystem::is_directory(directory, ec))
+        throw Error(fmt::format("cannot write {} to '{}': directory '{}' does not exist", what,
+                                path.string(), directory.string()));
+}
+
 struct RenderCommandOptions {
     std::string scene;
     std::string output;
@@ -90,6 +102,10 @@ struct RenderCommandOptions {
     std::string stats_json;
     bool verbose = false;
     uint64_t timeline_cycles = 0;
+    bool profile = false;
+    std::string annotate;
+    std::string heatmap;
+    std::string heatmap_metric = "cycles";
     uint64_t max_instructions = uint64_t(1) << 32;
 };
 
@@ -111,14 +127,19 @@ int run_render(const RenderCommandOptions& o) {
     const std::filesystem::path output =
         o.output.empty() ? std::filesystem::path(o.scene).stem().string() + ".png" : o.output;
     render::check_image_path(output);
-    if (!o.stats_json.empty()) {
-        const std::filesystem::path json_directory =
-            std::filesystem::path(o.stats_json).has_parent_path()
-                ? std::filesystem::path(o.stats_json).parent_path()
-                : std::filesystem::path(".");
-        if (std::error_code ec; !std::filesystem::is_directory(json_directory, ec))
-            throw Error(fmt::format("cannot write statistics to '{}': directory '{}' does not exist",
-                                    o.stats_json, json_directory.string()));
+    if (!o.stats_json.empty()) check_directory_of(o.stats_json, "statistics");
+    if (!o.annotate.empty()) check_directory_of(o.annotate, "the annotated listing");
+    const render::HeatMetric heat_metric = render::parse_heat_metric(o.heatmap_metric);
+    if (!o.heatmap.empty()) render::check_heatmap_path(o.heatmap);
+    options.profile = o.profile || !o.annotate.empty();
+    if (options.engine != render::Engine::timing) {
+        const char* needs = options.profile ? "--profile and --annotate need"
+                            : !o.heatmap.empty() ? "--heatmap needs"
+                                                 : nullptr;
+        if (needs)
+            throw Error(fmt::format("{} the cycle-level chip model: drop --native and --timing "
+                                    "none",
+                                    needs));
     }
 
     ProgressLine progress_line;
@@ -132,6 +153,25 @@ int run_render(const RenderCommandOptions& o) {
     stats::Registry registry;
     render::register_stats(result, registry);
     const stats::Snapshot snapshot(registry);
+    render::print_traffic(snapshot, options.chip.l2.line_bytes, std::cout);
+    if (result.profile) {
+        fmt::print("\n");
+        render::print_profile(*result.profile, std::cout);
+    }
+    if (!o.annotate.empty()) {
+        render::write_annotated_listing(o.annotate, *result.profile, options.kernel.string());
+        fmt::print("listing  {}\n", o.annotate);
+    }
+    if (!o.heatmap.empty()) {
+        const render::HeatmapFiles files =
+            render::write_heatmap(o.heatmap, result.timing->chip->work_items(),
+                                  result.scene.width, result.scene.height, heat_metric);
+        fmt::print("heatmap  {} ({} per pixel; raw values in {})\n", files.png.string(),
+                   render::metric_name(heat_metric), files.exr.string());
+        if (!files.legend_problem.empty())
+            fmt::print(stderr, "tpsim: warning: the heat map's legend has no text: {}\n",
+                       files.legend_problem);
+    }
     if (o.verbose) {
         fmt::print("\n# chip configuration (resolved)\n{}\n", timing::to_toml(options.chip));
         stats::print_text(snapshot, std::cout);
@@ -139,7 +179,9 @@ int run_render(const RenderCommandOptions& o) {
     if (!o.stats_json.empty()) {
         const std::filesystem::path json_path = o.stats_json;
         std::ofstream json(json_path);
-        json << render::stats_document(options, result, snapshot, json_path, {output, {}}).dump(1)
+        json << render::stats_document(options, result, snapshot, json_path,
+                                       {output, o.heatmap})
+                    .dump(1)
              << '\n';
         if (!json) throw Error(fmt::format("cannot write statistics to '{}'", o.stats_json));
         // The configuration as a file the user can pass back with -c.
@@ -191,6 +233,18 @@ Command add_render_command(CLI::App& app) {
     command->add_flag("-v,--verbose", o->verbose,
                       "Also print the resolved chip configuration and every statistic "
                       "(docs/statistics.md)");
+    command->add_flag("--profile", o->profile,
+                      "Profile the kernel by function and source line on the cycle-level chip "
+                      "(executions, stalls, L1 misses, DRAM bytes; about 10 % slower)");
+    command->add_option("--annotate", o->annotate,
+                        "Write the kernel's source annotated with its profile here (implies "
+                        "--profile)");
+    command->add_option("--heatmap", o->heatmap,
+                        "Write a false-colour PNG of the cost per pixel here (with a legend), and "
+                        "the raw values beside it as EXR");
+    command->add_option("--heatmap-metric", o->heatmap_metric,
+                        "What the heat map shows: cycles, instructions or dram_bytes per pixel")
+        ->capture_default_str();
     command->add_option("--timeline-cycles", o->timeline_cycles,
                         "Cycles per row of the statistics file's timeline; 0: adapt to the run "
                         "(200-400 rows)")

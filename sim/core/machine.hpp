@@ -50,6 +50,7 @@ struct Thread {
 /// What one instruction did, for the timing model (step()).
 struct StepRecord {
     uint32_t pc = 0;                    ///< address of the instruction
+    uint32_t atomic_result = 0;         ///< the value an atomic increment returned
     const isa::Decoded* insn = nullptr; ///< its pre-decoded form (registers, FU class)
     uint32_t mem_address = 0;           ///< effective address when mem_bytes != 0
     uint8_t mem_bytes = 0;              ///< access size; 0 = no memory access
@@ -57,6 +58,7 @@ struct StepRecord {
     bool taken = false;  ///< control left the fall-through path (branch, jump, trap)
     bool exited = false; ///< the instruction ended the thread
 };
+static_assert(sizeof(StepRecord) == 24, "the timing model buffers 128 per thread");
 
 struct Counters {
     uint64_t instructions = 0;

@@ -47,7 +47,9 @@ template <bool kRecord> class ThreadEnv {
     uint32_t atomic_inc(uint32_t global_register) {
         if (global_register >= kGlobalRegisters) [[unlikely]]
             bad_global_register(global_register);
-        return machine_.global_registers_[global_register]++;
+        const uint32_t old = machine_.global_registers_[global_register]++;
+        if constexpr (kRecord) record_->atomic_result = old;
+        return old;
     }
 
     bool read_csr(uint32_t csr, uint32_t& value) { return machine_.read_csr(id_, csr, value); }

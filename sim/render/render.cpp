@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "native_twin.hpp"
+#include "profile.hpp"
 #include "timing_run.hpp"
 #include "sim/timing/machine_source.hpp"
 #include "sim/core/error.hpp"
@@ -95,7 +96,11 @@ RenderResult render(const RenderOptions& options) {
         result.timing = run_timing(kernel.program, result.image, options.chip,
                                    {options.max_instructions,
                                     uint64_t(result.scene.width) * result.scene.height,
-                                    options.on_progress, options.timeline_interval});
+                                    options.on_progress, options.timeline_interval,
+                                    options.profile});
+        if (options.profile)
+            result.profile = std::make_shared<const Profile>(
+                profile_of(result.timing->chip->profile(), kernel.program));
         result.instructions = result.timing->instructions;
     } else {
         result.instructions = run_kernel(kernel, options.engine, result.image,

@@ -37,6 +37,7 @@ struct Progress {
 using ProgressCallback = std::function<void(const Progress&)>;
 
 struct TimingRun;  // timing_run.hpp
+struct Profile;    // profile.hpp
 
 /// A kernel, its ELF parsed once: the program every engine runs (the native twin is found next
 /// to the ELF) and what the pipeline needs to know of it.
@@ -64,6 +65,7 @@ struct RenderOptions {
     uint64_t max_instructions = uint64_t(1) << 32;  ///< per thread, for runaway kernels
     ProgressCallback on_progress;  ///< Engine::timing calls it now and then while it runs
     uint64_t timeline_interval = 0;  ///< Engine::timing: cycles per timeline row, 0 = adapt
+    bool profile = false;  ///< Engine::timing: collect the source-line profile (RenderResult)
 };
 
 /// Instruction counts of a simulated run.
@@ -85,6 +87,7 @@ struct RenderResult {
     InstructionCounts instructions;          ///< zero for the native engine
     uint32_t threads = 0;
     std::shared_ptr<const TimingRun> timing;  ///< Engine::timing: the chip and its counters
+    std::shared_ptr<const Profile> profile;   ///< RenderOptions::profile: by function and line
     double load_seconds = 0, bvh_seconds = 0, run_seconds = 0;  ///< host wall clock
 };
 

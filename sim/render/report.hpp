@@ -3,6 +3,8 @@
 #pragma once
 #include <filesystem>
 #include <iosfwd>
+#include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -18,6 +20,13 @@ void register_stats(const RenderResult& result, stats::Registry& registry);
 /// The human summary the report leads with: scene, kernel and chip (the configuration fields
 /// that differ from the defaults), memory image by section, BVH, rays, cycles, run speed.
 void print_summary(const RenderOptions& options, const RenderResult& result, std::ostream& out);
+
+/// The regions of the region/<r>/... statistics, in registration order (the table's rows).
+std::vector<std::string> region_names(const stats::Snapshot& snapshot);
+
+/// The compact traffic table: per region, L1 accesses and hit rate, L2 reads and hit rate, DRAM
+/// bytes read and written (whole lines of `line_bytes`) and the store payload they carried.
+void print_traffic(const stats::Snapshot& snapshot, uint32_t line_bytes, std::ostream& out);
 
 /// What a render wrote beside its statistics, named in the statistics file.
 struct OutputPaths {

@@ -25,8 +25,8 @@ struct TimingRun {
     InstructionCounts instructions;
 };
 
-/// What the chip is told about a run: the image's non-empty sections as regions, the
-/// kernel's text, and one work item per pixel (per ray for a ray batch).
+/// What the chip is told about a run: the image's non-empty sections and the kernel's ELF
+/// segments as regions, the kernel's text, and one work item per pixel (per ray for a batch).
 inline timing::ChipLayout chip_layout(const image::MemoryImage& image,
                                       const core::Machine& machine) {
     timing::ChipLayout layout;
@@ -36,6 +36,10 @@ inline timing::ChipLayout chip_layout(const image::MemoryImage& image,
                                       uint32_t(trax::map::kGlobalBase + section.begin),
                                       uint32_t(trax::map::kGlobalBase + section.begin +
                                                section.bytes)});
+    // The kernel's own ELF image (constants in .rodata, .data, .bss): below the global memory.
+    const auto& segments = machine.program().segments;
+    if (!segments.empty())
+        layout.regions.push_back({"kernel_data", segments.front().vaddr, segments.back().end()});
     layout.text_base = machine.text_base();
     layout.text_words = machine.text_words();
     const auto& header = image.header;
@@ -50,6 +54,7 @@ struct TimingRunOptions {
     uint64_t pixels = 0;           ///< scales the progress reports (0: none)
     ProgressCallback on_progress;  ///< every timing::Chip::kProgressInterval cycles
     uint64_t timeline_interval = 0;  ///< cycles between timeline samples; 0: adapt (Timeline)
+    bool profile = false;  ///< collect the per-instruction profile (Chip::profile)
 };
 
 /// Runs `program` over `image` (in place) on the chip `chip`. Throws core::Fault on a guest

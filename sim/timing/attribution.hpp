@@ -62,6 +62,12 @@ struct PcCounters {
 struct PcProfile {
     uint32_t text_base = 0;
     std::vector<PcCounters> words;
+
+    /// The counters of the instruction at `pc`, or nullptr outside the text.
+    PcCounters* at(uint32_t pc) {
+        const uint32_t index = (pc - text_base) / 4;
+        return index < words.size() ? &words[index] : nullptr;
+    }
 };
 
 /// One work item's costs: a thread's cycles, instructions and DRAM bytes from the atomicinc(0)

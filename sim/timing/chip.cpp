@@ -64,6 +64,11 @@ struct Chip::Tm {
         uint64_t mem_at = 0;         // a granted load/store's first cycle at the L1
         MemRequest mem_request;
         uint32_t lowest_local = trax::map::kLocalTop;  // for the local-store high-water mark
+        // The work item held (the last atomicinc(0) result; none before the first), since
+        // which cycle, and the instructions issued for it since then (Chip::work_items).
+        uint32_t item = UINT32_MAX;
+        uint64_t item_since = 0;
+        uint64_t item_instructions = 0;
         // Cycle each register becomes readable; the extra last slot is isa::kNoReg (an unused
         // operand) and stays 0, so the scoreboard check needs no branch per operand.
         std::array<uint64_t, isa::kNumRegs + 1> reg_ready{};
@@ -83,7 +88,7 @@ struct Chip::Tm {
     Tm(const ChipConfig& c, uint32_t id, size_t regions)
         : id(id), words((c.chip.tps_per_tm + 63) / 64), tps(c.chip.tps_per_tm),
           icache(c.icache, c.chip.tps_per_tm), l1(c.l1), awake_tps(words), pending_tps(words),
-          needs_port_tps(words), mem_waiting_tps(words), issuing_tps(words),
+          needs_port_tps(words), mem_waiting_tps(words), issuing_tps(words), asking_tps(words),
           wheel_slots(std::min(std::bit_ceil(longest_timed_sleep(c) + 1), kMaxWheelSlots)),
           sleeps_outlast_wheel(longest_timed_sleep(c) >= wheel_slots),
           wheel(wheel_slots * words), l1_traffic(regions) {
@@ -103,6 +108,9 @@ struct Chip::Tm {
         if (tp.wake_at != kNever) return;
         set_bit(awake_tps, i);
         add_operand_stalls(tp.asleep_on, now - tp.asleep_from);
+        if (profile)
+            if (PcCounters* pc = profile->at(tp.pending.pc))
+                pc->stalls[size_t(Stall::Operand)] += now - tp.asleep_from;
         tp.wake_at = now;
     }
     /// TP i leaves the awake set until cycle `at` (> now), when the wheel puts it back. A
@@ -148,6 +156,7 @@ struct Chip::Tm {
     TpBits needs_port_tps;   // ... that is a load/store to global memory (needs the L1 port)
     TpBits mem_waiting_tps;  // a granted load/store waits for its L1 access
     TpBits issuing_tps;      // won a unit this cycle
+    TpBits asking_tps;       // asked for a unit this cycle (kept only when profiling)
     // Timed sleeps: wheel_slots TpBits (a power of two above the longest sleep, at most
     // kMaxWheelSlots), the one for cycle t at t % wheel_slots.
     static constexpr uint64_t kMaxWheelSlots = 1024;
@@ -156,6 +165,7 @@ struct Chip::Tm {
     TpBits wheel;
     Counters counters;
     std::vector<LevelTraffic> l1_traffic;  // by region
+    PcProfile* profile = nullptr;          // the chip's, when it profiles
 };
 
 Chip::Chip(const ChipConfig& config, InstructionSource& source, const ChipLayout& layout)
@@ -192,6 +202,8 @@ Chip::Chip(const ChipConfig& config, InstructionSource& source, const ChipLayout
                 layout.regions[region_bounds_[r - 1].index].name,
                 layout.regions[region_bounds_[r].index].name));
     other_region_ = uint8_t(layout.regions.size());
+    work_items_.items.resize(layout.work_items);
+    if (layout.profile) profile_ = {layout.text_base, std::vector<PcCounters>(layout.text_words)};
     const size_t regions = layout.regions.size() + 1;
     l1_traffic_.resize(regions);
     l2_traffic_.resize(regions);
@@ -202,6 +214,7 @@ Chip::Chip(const ChipConfig& config, InstructionSource& source, const ChipLayout
     for (uint32_t t = 0; t < config.chip.num_tms; ++t) {
         tms_.push_back(std::make_unique<Tm>(config, t, regions));
         tms_.back()->running = config.chip.tps_per_tm;
+        if (layout.profile) tms_.back()->profile = &profile_;
     }
     for (uint32_t g = 0; g < config.num_l2(); ++g)
         l2s_.emplace_back(config.l2, config.l2.write_combining_lines);
@@ -286,11 +299,16 @@ bool Chip::run_cycles(uint64_t end) {
             }
         }
         tick_shared(now);
-        // TMs of up to 64 TPs (one word per bit set) take a loop without word loops.
-        if (config_.chip.tps_per_tm <= 64)
-            for (auto& tm : tms_) tick_tm<Source, 1>(*tm, now, source);
-        else
-            for (auto& tm : tms_) tick_tm<Source, 0>(*tm, now, source);
+        // TMs of up to 64 TPs (one word per bit set) take a loop without word loops; the
+        // profile's bookkeeping is compiled in only where it is collected.
+        const bool one_word = config_.chip.tps_per_tm <= 64;
+        for (auto& tm : tms_)
+            if (layout_.profile)
+                one_word ? tick_tm<Source, 1, true>(*tm, now, source)
+                         : tick_tm<Source, 0, true>(*tm, now, source);
+            else
+                one_word ? tick_tm<Source, 1, false>(*tm, now, source)
+                         : tick_tm<Source, 0, false>(*tm, now, source);
         cycles_ = now + 1;
         if (progress_ != last_progress_) {
             last_progress_ = progress_;
@@ -355,6 +373,8 @@ void Chip::tick_shared(uint64_t now) {
         ++(served.write ? t.writes : t.reads);
         t.payload_bytes += served.write ? served.bytes : line_bytes;
         t.moved_bytes += line_bytes;
+        item_costs(served.item).dram_bytes += line_bytes;
+        if (PcCounters* pc = profile_.at(served.pc)) pc->dram_bytes += line_bytes;
     }
     dram_.served().clear();
     for (auto& tm : tms_) {
@@ -371,10 +391,15 @@ void Chip::tick_shared(uint64_t now) {
     }
 }
 
-template <class Source, uint32_t kWords>
+template <class Source, uint32_t kWords, bool kProfile>
 void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
     const uint32_t words = kWords != 0 ? kWords : tm.words;  // kWords: known at compile time
     const uint32_t n = static_cast<uint32_t>(tm.tps.size());
+    // The profile's share of a stall or event: the instruction at `pc`.
+    const auto profile_at = [&](uint32_t pc) -> PcCounters& {
+        PcCounters* counters = profile_.at(pc);
+        return counters ? *counters : outside_text_;
+    };
     MemReply reply;
     while (tm.l1.pop_reply(now, reply)) {
         tm.tps[reply.request.source].reg_ready[reply.request.tag] = now;
@@ -398,6 +423,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
                                    : request.write                ? request.bytes
                                                                   : 0;
             count_access(tm.l1_traffic[request.region], outcome, request.bytes, moved);
+            if constexpr (kProfile) profile_at(request.pc).l1_misses += outcome == CacheOutcome::Miss;
         }
         tm.mem_waiting_tps[part.w] &= ~part.back(accessed);
     });
@@ -419,6 +445,11 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             now, fetching, [&](uint32_t bit) { return part.index(bit); },
             [&](uint32_t i) { return source.next_pc(first_thread + i); });
         counters.stalls[size_t(Stall::FetchConflict)] += count_bits(fetching & ~fetched);
+        if constexpr (kProfile)
+            for (uint64_t bits = fetching & ~fetched; bits != 0; bits &= bits - 1) {
+                const uint32_t thread = first_thread + part.index(uint32_t(std::countr_zero(bits)));
+                ++profile_at(source.next_pc(thread)).stalls[size_t(Stall::FetchConflict)];
+            }
         uint64_t needs_port = 0;
         for (uint64_t bits = fetched; bits != 0; bits &= bits - 1) {
             const auto bit = static_cast<uint32_t>(std::countr_zero(bits));
@@ -470,6 +501,9 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
                 }
             ++counters.stalls[size_t(Stall::Operand)];
             ++counters.operand_stalls[size_t(blocking)];
+            if constexpr (kProfile)
+                profile_at(tp.pending.pc).stalls[size_t(Stall::Operand)] +=
+                    operands_at == kNever ? 1 : operands_at - now;
             // Nothing can change this wait before operands_at but a reply for this TP, which
             // wakes it; so the cycles in between are operand stalls on `blocking`.
             if (operands_at == kNever) {
@@ -484,6 +518,12 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
         });
 
         counters.stalls[size_t(Stall::MemoryPort)] += count_bits(ready & port_taken);
+        if constexpr (kProfile) {
+            for_each_bit(w, ready & port_taken, [&](uint32_t i) {
+                ++profile_at(tps[i].pending.pc).stalls[size_t(Stall::MemoryPort)];
+            });
+            tm.asking_tps[w] = ready & ~port_taken;
+        }
         for (size_t p = 0; p < kPools; ++p)
             if (asking[p] != 0) {
                 tm.pools[p].request(w, asking[p]);
@@ -502,6 +542,10 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
     }
     for (uint32_t w = 0; w < words; ++w) {
         const uint64_t issuing = std::exchange(tm.issuing_tps[w], 0);
+        if constexpr (kProfile)
+            for_each_bit(w, tm.asking_tps[w] & ~issuing, [&](uint32_t i) {
+                ++profile_at(tps[i].pending.pc).stalls[size_t(Stall::FuBusy)];
+            });
         tm.pending_tps[w] &= ~issuing;
         tm.needs_port_tps[w] &= ~issuing;
         for_each_bit(w, issuing, [&](uint32_t i) {
@@ -512,6 +556,15 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             const Pool pool = tp.pending_pool;
             const uint64_t ready = now + latency_of_[size_t(pool)];
             ++counters.per_class[size_t(fu)];
+            // atomicinc(0) hands out the next work item; it is the first instruction of it.
+            if (fu == isa::FuClass::Atomic && d.imm == 0) [[unlikely]] {
+                charge_item(tp.item, now - tp.item_since, tp.item_instructions);
+                tp.item = s.atomic_result;
+                tp.item_since = now;
+                tp.item_instructions = 0;
+            }
+            ++tp.item_instructions;
+            if constexpr (kProfile) ++profile_at(s.pc).executions;
             uint64_t result_at = ready;
             if (fu == isa::FuClass::Atomic) {
                 result_at = kNever;  // set by the global-register reply
@@ -524,8 +577,8 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             } else if (s.mem_bytes != 0) {
                 set_bit(tm.mem_waiting_tps, i);
                 tp.mem_at = ready;
-                tp.mem_request = {s.mem_address, i,     d.rd, s.mem_store, region_of(s.mem_address),
-                                  s.mem_bytes,   s.pc};
+                tp.mem_request = {s.mem_address, i,     d.rd,   s.mem_store, region_of(s.mem_address),
+                                  s.mem_bytes,   s.pc, tp.item};
                 result_at = kNever;  // set by the L1 reply
             }
             if (d.rd != isa::kNoReg && !s.mem_store) {
@@ -535,6 +588,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             if (s.exited) {
                 clear_bit(tm.awake_tps, i);
                 --tm.running;
+                charge_item(tp.item, now + 1 - tp.item_since, tp.item_instructions);
             } else if (fu == isa::FuClass::Branch) {
                 // The bubble after a branch: no fetch before now + 1 + bubble.
                 const uint32_t bubble = s.taken ? config_.tp.branch_taken_penalty
@@ -542,6 +596,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
                 if (bubble != 0) {
                     counters.active_tp_cycles += bubble;
                     counters.stalls[size_t(Stall::Branch)] += bubble;
+                    if constexpr (kProfile) profile_at(s.pc).stalls[size_t(Stall::Branch)] += bubble;
                     tm.sleep_until(i, now + 1 + bubble, now);
                 }
             }

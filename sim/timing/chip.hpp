@@ -70,6 +70,13 @@ public:
     /// Threads that have not exited yet.
     uint32_t running_threads() const;
     const ChipLayout& layout() const { return layout_; }
+    /// Each thread's cycles, issued instructions and DRAM bytes, charged to the work item it
+    /// held (docs/statistics.md, "Work items"). Complete once the chip has finished; while
+    /// paused, an item still in progress is not charged yet.
+    const WorkItemCosts& work_items() const { return work_items_; }
+    /// Costs by instruction address (docs/statistics.md, "Profile"); empty unless
+    /// ChipLayout::profile. Complete once finished, as work_items().
+    const PcProfile& profile() const { return profile_; }
     /// Registers every counter under tm<i>/..., l2/<j>/..., dram/..., global_registers/...,
     /// chip-wide sums under chip/... and traffic by region under region/... . The chip and
     /// `registry` must outlive the printing.
@@ -88,8 +95,17 @@ private:
     /// The per-TM totals summed chip-wide (and the local-store high-water mark), once per
     /// run_until() call.
     void collect();
+    WorkItemCounters& item_costs(uint32_t item) {
+        return item < work_items_.items.size() ? work_items_.items[item] : work_items_.unassigned;
+    }
+    void charge_item(uint32_t item, uint64_t cycles, uint64_t instructions) {
+        WorkItemCounters& costs = item_costs(item);
+        costs.cycles += cycles;
+        costs.instructions += instructions;
+    }
     void tick_shared(uint64_t now);
-    template <class Source, uint32_t kWords>  // kWords: words per TP bit set, 0 = any
+    // kWords: words per TP bit set, 0 = any; kProfile: collect the PcProfile.
+    template <class Source, uint32_t kWords, bool kProfile>
     void tick_tm(Tm& tm, uint64_t now, Source& source);
 
     ChipConfig config_;
@@ -118,6 +134,9 @@ private:
     // Traffic by region (index as MemRequest::region); l1_traffic_ sums the TMs' in collect().
     std::vector<LevelTraffic> l1_traffic_, l2_traffic_, dram_traffic_;
     uint64_t local_payload_bytes_ = 0;  // summed in collect()
+    WorkItemCosts work_items_;
+    PcProfile profile_;
+    PcCounters outside_text_;  // takes the profile's share of a pc about to fault; never read
 };
 
 }  // namespace tpsim::timing

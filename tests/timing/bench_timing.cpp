@@ -1,4 +1,5 @@
-// bench_timing SCENE KERNEL_ELF [CONFIG.toml] [STATS.json]: renders on the cycle-level engine
+// bench_timing [--profile] SCENE KERNEL_ELF [CONFIG.toml] [STATS.json]: renders on the
+// cycle-level engine (with --profile, collecting the per-instruction profile)
 // without the image-file libraries (so valgrind --tool=callgrind can run it) and prints the
 // simulation speed in host CPU time. STATS.json gets the chip statistics, for comparing runs
 // before and after an optimisation (they must be identical).
@@ -19,8 +20,11 @@
 using namespace tpsim;
 
 int main(int argc, char** argv) try {
+    const bool profile = argc > 1 && std::string_view(argv[1]) == "--profile";
+    argc -= profile;
+    argv += profile;
     if (argc < 3) {
-        std::cerr << "usage: bench_timing SCENE KERNEL_ELF [CONFIG.toml] [STATS.json]\n";
+        std::cerr << "usage: bench_timing [--profile] SCENE KERNEL_ELF [CONFIG.toml] [STATS.json]\n";
         return 2;
     }
     const timing::ChipConfig chip = argc > 3 ? timing::load_config(argv[3]) : timing::ChipConfig{};
@@ -35,7 +39,9 @@ int main(int argc, char** argv) try {
                                                   image.read_only_bytes(), chip, uint64_t(1) << 32);
     core::Machine& machine = *machine_ptr;
     timing::MachineSource source(machine);
-    timing::Chip model(chip, source, render::chip_layout(image, machine));
+    timing::ChipLayout layout = render::chip_layout(image, machine);
+    layout.profile = profile;
+    timing::Chip model(chip, source, layout);
 
     const std::clock_t start = std::clock();
     model.run();

@@ -4,6 +4,8 @@
 #include "sim/core/elf_loader.hpp"
 #include "sim/render/render.hpp"
 #include "sim/render/timing_run.hpp"
+#include "sim/scene/bvh.hpp"
+#include "sim/scene/load_scene.hpp"
 #include "timing/machine_source.hpp"
 
 #include <catch2/catch.hpp>
@@ -186,4 +188,119 @@ TEST_CASE("write-combining writes a framebuffer to DRAM once per line, write-aro
             std::memcpy(&word, &image[12 * p + 4 * k], 4);
             REQUIRE(word == p + k);
         }
+}
+
+namespace {
+
+WorkItemCounters sum(const WorkItemCosts& costs) {
+    WorkItemCounters total = costs.unassigned;
+    for (const WorkItemCounters& item : costs.items) {
+        total.cycles += item.cycles;
+        total.instructions += item.instructions;
+        total.dram_bytes += item.dram_bytes;
+    }
+    return total;
+}
+
+/// Items plus unassigned hold every instruction, every DRAM byte and every TP-cycle of every
+/// thread until it exited.
+void check_work_item_totals(const Chip& chip) {
+    const Stats s(chip);
+    const WorkItemCounters total = sum(chip.work_items());
+    CHECK(total.instructions == s("chip/instructions"));
+    CHECK(total.dram_bytes == s("dram/bytes_read") + s("dram/bytes_written"));
+    CHECK(total.cycles == s("chip/active_tp_cycles"));
+    CHECK(chip.work_items().unassigned.instructions > 0); // startup and the fetch past the end
+}
+
+} // namespace
+
+TEST_CASE("costs by work item add up to the chip's totals", "[attribution][work_items]") {
+    for (const ChipConfig& chip : {ChipConfig{}, tiny(), odd_chip()}) {
+        const render::RenderResult result = render_on(chip, TPSIM_SCENE_DIR "/cornell.toml", 32);
+        const WorkItemCosts& costs = result.timing->chip->work_items();
+        REQUIRE(costs.items.size() == 32 * 32);
+        check_work_item_totals(*result.timing->chip);
+        for (const WorkItemCounters& item : costs.items) {
+            REQUIRE(item.instructions > 0);
+            REQUIRE(item.cycles >= item.instructions);
+        }
+    }
+}
+
+TEST_CASE("each framebuffer pixel costs its 12 instructions and, with write-around, its three "
+          "line writes",
+          "[attribution][work_items]") {
+    const FramebufferRun run(tiny());
+    const WorkItemCosts& costs = run.chip->work_items();
+    REQUIRE(costs.items.size() == kPixels);
+    check_work_item_totals(*run.chip);
+    for (const WorkItemCounters& item : costs.items) {
+        REQUIRE(item.instructions == 12); // atominc, bge, 6 address and value ops, 3 sw, j
+        REQUIRE(item.dram_bytes == 3 * 64);
+    }
+    CHECK(costs.unassigned.dram_bytes == 0);
+}
+
+namespace {
+
+/// The tracer on the 32x32 Cornell box with the profile on.
+struct ProfiledRun {
+    explicit ProfiledRun(const ChipConfig& config) {
+        scene::Scene scene = scene::load_scene(TPSIM_SCENE_DIR "/cornell.toml");
+        scene.width = scene.height = 32;
+        scene::BvhConfig bvh_config;
+        bvh_config.traversal_stack_entries = trax::layout::kTraversalStackEntries;
+        const scene::Bvh bvh = scene::build_bvh(scene.triangles, bvh_config);
+        image =
+            image::build_memory_image(scene, &bvh, config.chip.num_tms * config.chip.tps_per_tm);
+        core::MachineConfig machine_config = machine_config_for(config);
+        machine_config.global_bytes = uint32_t(image.bytes());
+        machine_config.read_only_global_bytes = uint32_t(image.read_only_bytes());
+        machine = std::make_unique<core::Machine>(core::load_elf(TPSIM_KERNEL_DIR "/tracer.elf"),
+                                                  machine_config);
+        std::memcpy(machine->memory().global().data(), image.words.data(), image.bytes());
+        source = std::make_unique<MachineSource>(*machine);
+        ChipLayout layout = render::chip_layout(image, *machine);
+        layout.profile = true;
+        chip = std::make_unique<Chip>(config, *source, layout);
+        chip->run();
+    }
+    image::MemoryImage image;
+    std::unique_ptr<core::Machine> machine;
+    std::unique_ptr<MachineSource> source;
+    std::unique_ptr<Chip> chip;
+};
+
+} // namespace
+
+TEST_CASE("the profile by instruction adds up to the chip's totals", "[attribution][profile]") {
+    for (const ChipConfig& config : {ChipConfig{}, tiny(), odd_chip()}) {
+        const ProfiledRun run(config);
+        const Chip& chip = *run.chip;
+        const Stats s(chip);
+        const PcProfile& profile = chip.profile();
+        REQUIRE(profile.words.size() == run.machine->text_words());
+        PcCounters total;
+        for (const PcCounters& pc : profile.words) {
+            total.executions += pc.executions;
+            for (size_t c = 0; c < kStallCauses; ++c)
+                total.stalls[c] += pc.stalls[c];
+            total.l1_misses += pc.l1_misses;
+            total.dram_bytes += pc.dram_bytes;
+        }
+        CHECK(total.executions == s("chip/instructions"));
+        const char* causes[] = {"fetch_conflict", "branch", "fu_busy", "memory_port", "operand"};
+        for (size_t c = 0; c < kStallCauses; ++c) {
+            INFO(causes[c]);
+            CHECK(total.stalls[c] == s(fmt::format("chip/stalls/{}", causes[c])));
+            CHECK(total.stalls[c] > 0);
+        }
+        CHECK(total.l1_misses == s("chip/l1/misses"));
+        CHECK(total.dram_bytes == s("dram/bytes_read") + s("dram/bytes_written"));
+        // The same run without the profile: the profile changes nothing else.
+        const render::RenderResult plain = render_on(config, TPSIM_SCENE_DIR "/cornell.toml", 32);
+        CHECK(plain.timing->chip->profile().words.empty());
+        CHECK(Stats(*plain.timing->chip)("chip/cycles") == s("chip/cycles"));
+    }
 }
