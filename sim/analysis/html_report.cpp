@@ -390,10 +390,12 @@ void profile_table(Page& page, const std::vector<ProfileEntry>& entries, double 
             stalls += cycles;
         page.body << "<tr>";
         if (lines)
-            page.body << fmt::format("<td class=\"code\">{}:{}</td>", escape(e.file), e.line);
-        page.body << fmt::format("<td class=\"code\">{}</td>{}<td class=\"num\">{}</td><td "
-                                 "class=\"num\">{}</td><td class=\"num\">{}</td><td "
-                                 "class=\"num\">{}</td><td class=\"num\">{}</td></tr>\n",
+            page.body << fmt::format("<td class=\"code line\">{}:{}</td>", escape(e.file), e.line);
+        // Demangled names run long: one line each, cut with an ellipsis, in full on hover.
+        page.body << fmt::format("<td class=\"code name\" title=\"{0}\">{0}</td>{1}<td "
+                                 "class=\"num\">{2}</td><td "
+                                 "class=\"num\">{3}</td><td class=\"num\">{4}</td><td "
+                                 "class=\"num\">{5}</td><td class=\"num\">{6}</td></tr>\n",
                                  escape(e.function), share_cell(total > 0 ? e.cycles / total : 0),
                                  readable(e.cycles), readable(e.executions), readable(stalls),
                                  readable(e.l1_misses), readable(e.dram_bytes));
