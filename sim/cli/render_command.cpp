@@ -88,6 +88,8 @@ struct RenderCommandOptions {
     bool native = false;
     std::string timing = "cycle";
     std::string stats_json;
+    bool verbose = false;
+    uint64_t timeline_cycles = 0;
     uint64_t max_instructions = uint64_t(1) << 32;
 };
 
@@ -99,6 +101,7 @@ int run_render(const RenderCommandOptions& o) {
                      : o.timing == "cycle" ? render::Engine::timing
                                            : render::Engine::functional;
     options.max_instructions = o.max_instructions;
+    options.timeline_interval = o.timeline_cycles;
     if (!o.config.empty()) options.chip = timing::load_config(o.config);
     for (const std::string& assignment : o.overrides) timing::apply_override(options.chip, assignment);
     options.bvh.builder = o.bvh == "binned" ? scene::BvhBuilder::binned : scene::BvhBuilder::sweep;
@@ -124,17 +127,23 @@ int run_render(const RenderCommandOptions& o) {
     progress_line.clear();
     render::write_image(output, result.rgb, result.scene.width, result.scene.height);
 
-    fmt::print("# chip configuration (resolved)\n{}\n", timing::to_toml(options.chip));
     render::print_summary(options, result, std::cout);
-    fmt::print("image    {}\n\n", output.string());
+    fmt::print("image    {}\n", output.string());
     stats::Registry registry;
     render::register_stats(result, registry);
-    stats::print_text(registry, std::cout);
+    const stats::Snapshot snapshot(registry);
+    render::print_traffic(snapshot, options.chip.l2.line_bytes, std::cout);
+    if (o.verbose) {
+        fmt::print("\n# chip configuration (resolved)\n{}\n", timing::to_toml(options.chip));
+        stats::print_text(snapshot, std::cout);
+    }
     if (!o.stats_json.empty()) {
-        std::ofstream json(o.stats_json);
-        stats::print_json(registry, json);
+        const std::filesystem::path json_path = o.stats_json;
+        std::ofstream json(json_path);
+        json << render::stats_document(options, result, snapshot, json_path, {output, {}}).dump(1)
+             << '\n';
         if (!json) throw Error(fmt::format("cannot write statistics to '{}'", o.stats_json));
-        // The JSON holds numbers only; the configuration that produced them goes beside it.
+        // The configuration as a file the user can pass back with -c.
         const std::filesystem::path config_path =
             std::filesystem::path(o.stats_json).replace_extension(".config.toml");
         std::ofstream config(config_path);
@@ -177,8 +186,16 @@ Command add_render_command(CLI::App& app) {
         ->check(CLI::IsMember({"cycle", "none"}))
         ->capture_default_str();
     command->add_option("--stats-json", o->stats_json,
-                        "Also write the statistics as JSON here, and the chip configuration "
-                        "beside it (PATH with extension .config.toml)");
+                        "Also write the statistics file (JSON, read by tpsim compare and tpsim "
+                        "report) here, and the chip configuration beside it (PATH with "
+                        "extension .config.toml)");
+    command->add_flag("-v,--verbose", o->verbose,
+                      "Also print the resolved chip configuration and every statistic "
+                      "(docs/statistics.md)");
+    command->add_option("--timeline-cycles", o->timeline_cycles,
+                        "Cycles per row of the statistics file's timeline; 0: adapt to the run "
+                        "(200-400 rows)")
+        ->capture_default_str();
     command->add_option("--max-instructions", o->max_instructions,
                         "Instructions a thread may run before it is stopped as a runaway")
         ->check(kPositiveCount)

@@ -22,19 +22,18 @@
 #include "kernel/memory_map.hpp"
 
 namespace tpsim::core {
-namespace {
 
-constexpr const char* kBuildHint =
-    "build it with clang --target=riscv32-unknown-elf -march=rv32imf -mabi=ilp32f";
-
-/// A C++ symbol as the student wrote it ("(anonymous namespace)::depth(int)"), or the name
-/// itself when it is not a mangled C++ name.
 std::string demangle(const std::string& name) {
     int status = 0;
     const std::unique_ptr<char, void (*)(void*)> plain(
         abi::__cxa_demangle(name.c_str(), nullptr, nullptr, &status), std::free);
     return status == 0 && plain ? std::string(plain.get()) : name;
 }
+
+namespace {
+
+constexpr const char* kBuildHint =
+    "build it with clang --target=riscv32-unknown-elf -march=rv32imf -mabi=ilp32f";
 
 [[noreturn]] void reject(const std::string& name, const std::string& problem) {
     throw Error(fmt::format("cannot load '{}': {}", name, problem));
@@ -213,11 +212,26 @@ std::vector<Symbol> read_functions(Elf* elf, const std::vector<Segment>& segment
     return functions;
 }
 
-/// File name without directories.
-std::string base_name(const char* path) {
-    std::string file = path ? path : "?";
+/// A source file as DWARF names it: the file name alone (for messages) and the full path, which
+/// libdw has already joined from DW_AT_comp_dir, the line table's directory and the name;
+/// lexically_normal makes "dir/./x.hpp" and "dir/x.hpp" one file.
+Program::SourceFile source_file(const char* dwarf_path) {
+    std::string file = dwarf_path ? dwarf_path : "?";
+    const std::string path = std::filesystem::path(file).lexically_normal().string();
     if (auto slash = file.rfind('/'); slash != std::string::npos) file = file.substr(slash + 1);
-    return file;
+    return {file, path};
+}
+
+/// The name of an inlined function: its abstract instance (DW_AT_abstract_origin), or the
+/// declaration that one points to (DW_AT_specification), carries it; dwarf_attr_integrate
+/// follows both.
+std::string inlined_function_name(Dwarf_Die* inlined) {
+    Dwarf_Attribute attribute;
+    if (const char* linkage =
+            dwarf_formstring(dwarf_attr_integrate(inlined, DW_AT_linkage_name, &attribute)))
+        return demangle(linkage);
+    const char* name = dwarf_formstring(dwarf_attr_integrate(inlined, DW_AT_name, &attribute));
+    return name ? name : "";
 }
 
 /// Collects the inlined calls below `die` (depth = nesting level) with their call sites.
@@ -234,11 +248,14 @@ void read_inlined_calls(Dwarf_Die* die, Dwarf_Files* files, uint32_t depth, Prog
                 dwarf_formudata(dwarf_attr(&child, DW_AT_call_file, &attribute), &file) == 0 &&
                 dwarf_formudata(dwarf_attr(&child, DW_AT_call_line, &attribute), &line) == 0;
             if (has_site && files) {
-                const SourceLocation site{base_name(dwarf_filesrc(files, file, nullptr, nullptr)),
-                                          uint32_t(line)};
+                const Program::SourceFile source =
+                    source_file(dwarf_filesrc(files, file, nullptr, nullptr));
+                const SourceLocation site{source.file, uint32_t(line), source.path};
+                const std::string function = inlined_function_name(&child);
                 Dwarf_Addr base = 0, low = 0, high = 0;
                 for (ptrdiff_t at = 0; (at = dwarf_ranges(&child, at, &base, &low, &high)) > 0;)
-                    program.inlined_calls.push_back({uint32_t(low), uint32_t(high), depth, site});
+                    program.inlined_calls.push_back(
+                        {uint32_t(low), uint32_t(high), depth, site, function});
             }
         }
         read_inlined_calls(&child, files, depth + 1, program);
@@ -267,9 +284,9 @@ void read_lines(Elf* elf, Program& program) {
                 if (!line || dwarf_lineaddr(line, &addr) != 0 || dwarf_lineno(line, &lineno) != 0 ||
                     dwarf_lineendsequence(line, &end) != 0)
                     continue;
-                const std::string file = base_name(dwarf_linesrc(line, nullptr, nullptr));
-                auto [it, inserted] = file_index.try_emplace(file, program.line_files.size());
-                if (inserted) program.line_files.push_back(file);
+                Program::SourceFile file = source_file(dwarf_linesrc(line, nullptr, nullptr));
+                auto [it, inserted] = file_index.try_emplace(file.path, program.line_files.size());
+                if (inserted) program.line_files.push_back(std::move(file));
                 program.line_rows.push_back({uint32_t(addr), uint32_t(lineno), it->second, end});
             }
         }
@@ -319,18 +336,37 @@ std::optional<SourceLocation> Program::source_at(uint32_t pc) const {
     while (row->line == 0 && !row->end_sequence && row != line_rows.begin())
         --row;
     if (row->end_sequence || row->line == 0) return std::nullopt;
-    return SourceLocation{line_files[row->file], row->line};
+    const SourceFile& file = line_files[row->file];
+    return SourceLocation{file.file, row->line, file.path};
 }
 
-std::vector<SourceLocation> Program::inlined_call_sites(uint32_t pc) const {
-    std::vector<const InlinedCall*> around;
-    for (const InlinedCall& call : inlined_calls)
+namespace {
+
+/// The inlined calls whose ranges hold pc, innermost first.
+std::vector<const Program::InlinedCall*>
+inlined_around(const std::vector<Program::InlinedCall>& calls, uint32_t pc) {
+    std::vector<const Program::InlinedCall*> around;
+    for (const Program::InlinedCall& call : calls)
         if (pc >= call.low && pc < call.high) around.push_back(&call);
-    std::sort(around.begin(), around.end(),
-              [](const InlinedCall* a, const InlinedCall* b) { return a->depth > b->depth; });
+    std::stable_sort(around.begin(), around.end(),
+                     [](const auto* a, const auto* b) { return a->depth > b->depth; });
+    return around;
+}
+
+} // namespace
+
+std::vector<SourceLocation> Program::inlined_call_sites(uint32_t pc) const {
     std::vector<SourceLocation> sites;
-    for (const InlinedCall* call : around) sites.push_back(call->call_site);
+    for (const InlinedCall* call : inlined_around(inlined_calls, pc))
+        sites.push_back(call->call_site);
     return sites;
+}
+
+std::string Program::source_function_at(uint32_t pc) const {
+    if (const auto around = inlined_around(inlined_calls, pc); !around.empty())
+        return around.front()->function;
+    const Symbol* symbol = function_at(pc);
+    return symbol ? demangle(symbol->name) : "";
 }
 
 const Segment* Program::segment_at(uint32_t addr) const {

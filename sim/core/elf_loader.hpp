@@ -27,8 +27,11 @@ struct Symbol {
 };
 
 struct SourceLocation {
-    std::string file; ///< file name as recorded by the compiler (no directory)
+    std::string file; ///< file name as recorded by the compiler (no directory), for messages
     uint32_t line = 0;
+    /// The full path DWARF gives (DW_AT_comp_dir, the line table's directory and the file
+    /// name), for reading the source; it need not exist on this machine.
+    std::string path;
 };
 
 /// Everything the simulator needs from the ELF; no libelf handles are kept.
@@ -49,6 +52,9 @@ class Program {
     /// kernel line that called storef() when pc is in storef's inlined body); empty if pc is in
     /// no inlined code or the ELF has no DWARF.
     std::vector<SourceLocation> inlined_call_sites(uint32_t pc) const;
+    /// The function whose source holds source_at(pc): the innermost function inlined at pc,
+    /// else the symbol's (both demangled); "" when DWARF or the symbol table names none.
+    std::string source_function_at(uint32_t pc) const;
     /// The segment holding addr, or nullptr.
     const Segment* segment_at(uint32_t addr) const;
 
@@ -60,15 +66,23 @@ class Program {
         bool end_sequence;
     };
     std::vector<LineRow> line_rows;
-    std::vector<std::string> line_files;
+    struct SourceFile {
+        std::string file, path; ///< as in SourceLocation
+    };
+    std::vector<SourceFile> line_files;
     /// Loader-internal: one address range of an inlined call (DW_TAG_inlined_subroutine).
     struct InlinedCall {
         uint32_t low, high;  ///< [low, high)
         uint32_t depth;      ///< nesting depth in the DIE tree: larger = more inner
         SourceLocation call_site;
+        std::string function;  ///< the inlined function, demangled ("" if DWARF names none)
     };
     std::vector<InlinedCall> inlined_calls;
 };
+
+/// A C++ symbol as the student wrote it ("(anonymous namespace)::depth(int)"), or the name
+/// itself when it is not a mangled C++ name.
+std::string demangle(const std::string& name);
 
 /// Reads and validates an ELF file. Throws tpsim::Error (one line naming the file, the problem
 /// and the fix) for anything tpsim cannot run.

@@ -8,7 +8,6 @@
 #include "native_twin.hpp"
 #include "timing_run.hpp"
 #include "sim/timing/machine_source.hpp"
-#include "sim/core/elf_loader.hpp"
 #include "sim/core/error.hpp"
 #include "sim/core/machine.hpp"
 #include "sim/scene/load_scene.hpp"
@@ -20,18 +19,14 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-/// Runs the kernel ELF on the functional machine over the image, in place.
-InstructionCounts run_functional(const std::filesystem::path& kernel, image::MemoryImage& image,
+/// Runs the kernel on the functional machine over the image, in place.
+InstructionCounts run_functional(const core::Program& program, image::MemoryImage& image,
                                  const timing::ChipConfig& chip, uint64_t max_instructions) {
-    core::MachineConfig config = timing::machine_config_for(chip);
-    config.global_bytes = uint32_t(image.bytes());
-    config.read_only_global_bytes = uint32_t(image.read_only_bytes());
-    config.max_instructions = max_instructions;
-    core::Machine machine(core::load_elf(kernel), config);
-    std::memcpy(machine.memory().global().data(), image.words.data(), image.bytes());
-    machine.run();
-    std::memcpy(image.words.data(), machine.memory().global().data(), image.bytes());
-    return InstructionCounts::of(machine.counters());
+    const auto machine =
+        timing::make_machine(program, image.words, image.read_only_bytes(), chip, max_instructions);
+    machine->run();
+    std::memcpy(image.words.data(), machine->memory().global().data(), image.bytes());
+    return InstructionCounts::of(machine->counters());
 }
 
 }  // namespace
@@ -45,25 +40,31 @@ InstructionCounts InstructionCounts::of(const core::Counters& counters) {
     return counts;
 }
 
-bool kernel_uses_bvh(const std::filesystem::path& kernel_elf) {
-    const core::Program program = core::load_elf(kernel_elf.string());
+Kernel Kernel::load(const std::filesystem::path& elf) {
+    return {elf, core::load_elf(elf.string())};
+}
+
+bool Kernel::uses_bvh() const {
     for (const core::Symbol& symbol : program.functions)
         if (symbol.name == trax::layout::kUsesBvhSymbol) return true;
     return false;
 }
 
-InstructionCounts run_kernel(const std::filesystem::path& kernel_elf, Engine engine,
-                             image::MemoryImage& image, const timing::ChipConfig& chip,
-                             uint64_t max_instructions) {
+InstructionCounts run_kernel(const Kernel& kernel, Engine engine, image::MemoryImage& image,
+                             const timing::ChipConfig& chip, uint64_t max_instructions) {
     switch (engine) {
-        case Engine::functional: return run_functional(kernel_elf, image, chip, max_instructions);
+        case Engine::functional:
+            return run_functional(kernel.program, image, chip, max_instructions);
         case Engine::native:
-            run_native_twin(native_twin_of(kernel_elf), image.words,
+            run_native_twin(native_twin_of(kernel.elf), image.words,
                             chip.chip.num_tms * chip.chip.tps_per_tm, chip.chip.num_tms,
                             chip.chip.tps_per_tm);
             break;
-        case Engine::timing:
-            return run_timing(kernel_elf, image, chip, max_instructions)->instructions;
+        case Engine::timing: {
+            TimingRunOptions watch;
+            watch.max_instructions = max_instructions;
+            return run_timing(kernel.program, image, chip, watch)->instructions;
+        }
     }
     return {};
 }
@@ -76,8 +77,9 @@ RenderResult render(const RenderOptions& options) {
     if (options.image_height != 0) result.scene.height = options.image_height;
     result.load_seconds = seconds_since(start);
 
+    const Kernel kernel = Kernel::load(options.kernel);
     std::optional<scene::Bvh> bvh;
-    if (kernel_uses_bvh(options.kernel)) {
+    if (kernel.uses_bvh()) {
         start = std::chrono::steady_clock::now();
         scene::BvhConfig config = options.bvh;
         config.traversal_stack_entries = trax::layout::kTraversalStackEntries;
@@ -90,13 +92,13 @@ RenderResult render(const RenderOptions& options) {
 
     start = std::chrono::steady_clock::now();
     if (options.engine == Engine::timing) {
-        result.timing = run_timing(options.kernel, result.image, options.chip,
-                                   options.max_instructions,
-                                   uint64_t(result.scene.width) * result.scene.height,
-                                   options.on_progress);
+        result.timing = run_timing(kernel.program, result.image, options.chip,
+                                   {options.max_instructions,
+                                    uint64_t(result.scene.width) * result.scene.height,
+                                    options.on_progress, options.timeline_interval});
         result.instructions = result.timing->instructions;
     } else {
-        result.instructions = run_kernel(options.kernel, options.engine, result.image,
+        result.instructions = run_kernel(kernel, options.engine, result.image,
                                          options.chip, options.max_instructions);
     }
     result.run_seconds = seconds_since(start);

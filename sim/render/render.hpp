@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "isa/isa.hpp"
+#include "sim/core/elf_loader.hpp"
 #include "sim/image/memory_image.hpp"
 #include "sim/scene/bvh.hpp"
 #include "sim/scene/scene.hpp"
@@ -37,6 +38,18 @@ using ProgressCallback = std::function<void(const Progress&)>;
 
 struct TimingRun;  // timing_run.hpp
 
+/// A kernel, its ELF parsed once: the program every engine runs (the native twin is found next
+/// to the ELF) and what the pipeline needs to know of it.
+struct Kernel {
+    std::filesystem::path elf;
+    core::Program program;
+
+    /// Throws tpsim::Error (one line) for an ELF tpsim cannot run.
+    static Kernel load(const std::filesystem::path& elf);
+    /// Does the kernel traverse a BVH (define trax::layout::kUsesBvhSymbol)?
+    bool uses_bvh() const;
+};
+
 struct RenderOptions {
     std::filesystem::path scene;   ///< scene file (.toml) or a bare mesh
     std::filesystem::path kernel;  ///< kernel ELF; its twin is found next to it
@@ -50,6 +63,7 @@ struct RenderOptions {
     timing::ChipConfig chip;       ///< shape (TMs x TPs) and local-store size
     uint64_t max_instructions = uint64_t(1) << 32;  ///< per thread, for runaway kernels
     ProgressCallback on_progress;  ///< Engine::timing calls it now and then while it runs
+    uint64_t timeline_interval = 0;  ///< Engine::timing: cycles per timeline row, 0 = adapt
 };
 
 /// Instruction counts of a simulated run.
@@ -78,14 +92,11 @@ struct RenderResult {
 /// also when a traversal stack overflowed.
 RenderResult render(const RenderOptions& options);
 
-/// Does the kernel ELF traverse a BVH (define trax::layout::kUsesBvhSymbol)?
-bool kernel_uses_bvh(const std::filesystem::path& kernel_elf);
-
 /// Runs a kernel over a memory image, in place, on the chosen engine with the chip's thread
 /// shape: the building block of render() and of tests that bring their own image (ray_query).
 /// Returns the instruction counts (zero for the native twin).
-InstructionCounts run_kernel(const std::filesystem::path& kernel_elf, Engine engine,
-                             image::MemoryImage& image, const timing::ChipConfig& chip,
+InstructionCounts run_kernel(const Kernel& kernel, Engine engine, image::MemoryImage& image,
+                             const timing::ChipConfig& chip,
                              uint64_t max_instructions = uint64_t(1) << 32);
 
 }  // namespace tpsim::render

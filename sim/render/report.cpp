@@ -1,5 +1,6 @@
 #include "report.hpp"
 
+#include <algorithm>
 #include <ostream>
 
 #include <fmt/format.h>
@@ -8,6 +9,93 @@
 #include "timing_run.hpp"
 
 namespace tpsim::render {
+
+namespace {
+
+std::string_view engine_name(Engine engine) {
+    switch (engine) {
+        case Engine::functional: return "functional";
+        case Engine::native: return "native";
+        case Engine::timing: return "timing";
+    }
+    return "";
+}
+
+/// "12.3 KiB": bytes in the largest binary unit that keeps the number >= 1.
+std::string bytes_text(double bytes) {
+    const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB"};
+    size_t u = 0;
+    while (bytes >= 1024 && u + 1 < std::size(units)) {
+        bytes /= 1024;
+        ++u;
+    }
+    return u == 0 ? fmt::format("{:.0f} B", bytes) : fmt::format("{:.1f} {}", bytes, units[u]);
+}
+
+/// "12,345,678": a count with thousands separators.
+std::string count_text(double count) {
+    const std::string digits = fmt::format("{}", uint64_t(count));
+    std::string grouped;
+    for (size_t i = 0; i < digits.size(); ++i) {
+        if (i > 0 && (digits.size() - i) % 3 == 0) grouped += ',';
+        grouped += digits[i];
+    }
+    return grouped;
+}
+
+std::string percent_text(double numerator, double denominator) {
+    return denominator > 0 ? fmt::format("{:.1f}%", 100 * numerator / denominator) : "-";
+}
+
+}  // namespace
+
+std::vector<std::string> region_names(const stats::Snapshot& snapshot) {
+    std::vector<std::string> names;
+    for (const stats::Value& v : snapshot.values()) {
+        if (!v.name.starts_with("region/")) continue;
+        const size_t end = v.name.find('/', 7);
+        const std::string name = v.name.substr(7, end - 7);
+        if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+    }
+    return names;
+}
+
+void print_traffic(const stats::Snapshot& snapshot, uint32_t line_bytes, std::ostream& out) {
+    const std::vector<std::string> regions = region_names(snapshot);
+    if (regions.empty()) return;
+    const auto get = [&](const std::string& region, std::string_view leaf) {
+        return snapshot.value(fmt::format("region/{}/{}", region, leaf));
+    };
+    fmt::print(out, "\ntraffic  {:<14} {:>12} {:>7} {:>10} {:>7} {:>11} {:>12} {:>13}\n", "region",
+               "L1 accesses", "L1 hit", "L2 reads", "L2 hit", "DRAM read", "DRAM written",
+               "store payload");
+    for (const std::string& region : regions) {
+        if (region == "local_store") {
+            fmt::print(out, "         {:<14} {:>12}  loads and stores, {} (private: no cache)\n",
+                       "local store",
+                       count_text(get(region, "local_store/loads") +
+                                  get(region, "local_store/stores")),
+                       bytes_text(get(region, "local_store/payload_bytes")));
+            continue;
+        }
+        if (region == "instruction_fetch") {
+            fmt::print(out, "         {:<14} {:>12}  fetches (the I-cache never misses)\n",
+                       "instructions", count_text(get(region, "icache/fetches")));
+            continue;
+        }
+        const double l1_reads = get(region, "l1/reads"), l1_writes = get(region, "l1/writes");
+        const double l2_reads = get(region, "l2/reads");
+        if (l1_reads + l1_writes == 0) continue;  // an untouched region
+        // DRAM moves whole lines; the store payload is what the kernel's stores carried.
+        const double read_bytes = get(region, "dram/reads") * line_bytes;
+        const double written_bytes = get(region, "dram/writes") * line_bytes;
+        const double store_payload = get(region, "dram/payload_bytes") - read_bytes;
+        fmt::print(out, "         {:<14} {:>12} {:>7} {:>10} {:>7} {:>11} {:>12} {:>13}\n", region,
+                   count_text(l1_reads + l1_writes), percent_text(get(region, "l1/hits"), l1_reads),
+                   count_text(l2_reads), percent_text(get(region, "l2/hits"), l2_reads),
+                   bytes_text(read_bytes), bytes_text(written_bytes), bytes_text(store_payload));
+    }
+}
 
 void register_stats(const RenderResult& r, stats::Registry& reg) {
     const auto number = [&reg](std::string name, auto get, std::string description,
@@ -94,6 +182,17 @@ void print_summary(const RenderOptions& options, const RenderResult& r, std::ost
                : options.engine == Engine::timing ? "the cycle-level chip model"
                                                   : "the functional simulator",
                options.chip.chip.num_tms, options.chip.chip.tps_per_tm, r.threads);
+    std::string changed;
+    const std::vector<timing::ConfigField> defaults = timing::config_fields({});
+    const std::vector<timing::ConfigField> fields = timing::config_fields(options.chip);
+    for (size_t i = 0; i < fields.size(); ++i)
+        if (fields[i].value != defaults[i].value)
+            changed += fmt::format("{}{}={}", changed.empty() ? "" : ", ", fields[i].key,
+                                   fields[i].is_bool ? (fields[i].value ? "true" : "false")
+                                                     : std::to_string(fields[i].value));
+    fmt::print(out, "config   {}\n",
+               changed.empty() ? "the defaults (configs/trax.toml)"
+                               : "the defaults (configs/trax.toml) except " + changed);
     fmt::print(out, "memory   {:.1f} KiB ({:.1f} KiB read-only scene):", double(r.image.bytes()) / 1024,
                double(r.image.read_only_bytes()) / 1024);
     const char* separator = " ";
@@ -133,6 +232,47 @@ void print_summary(const RenderOptions& options, const RenderResult& r, std::ost
                    double(r.instructions.total) / r.run_seconds / 1e6);
     else
         fmt::print(out, "run      {:.3f} s\n", r.run_seconds);
+}
+
+nlohmann::ordered_json stats_document(const RenderOptions& options, const RenderResult& r,
+                                      const stats::Snapshot& snapshot,
+                                      const std::filesystem::path& json_path,
+                                      const OutputPaths& outputs) {
+    const std::filesystem::path base = json_path.has_parent_path()
+                                           ? json_path.parent_path()
+                                           : std::filesystem::path(".");
+    const auto relative = [&](const std::filesystem::path& path) {
+        return std::filesystem::proximate(path, base).generic_string();
+    };
+    nlohmann::ordered_json doc;
+    doc["format"] = "tpsim-stats";
+    doc["version"] = kStatsFileVersion;
+    nlohmann::ordered_json& run = doc["run"];
+    run["scene"] = options.scene.generic_string();
+    run["kernel"] = options.kernel.generic_string();
+    run["kernel_name"] = options.kernel.stem().string();
+    run["engine"] = engine_name(options.engine);
+    run["bvh_builder"] = options.bvh.builder == scene::BvhBuilder::binned ? "binned" : "sweep";
+    run["max_leaf"] = options.bvh.max_leaf_size;
+    run["width"] = r.scene.width;
+    run["height"] = r.scene.height;
+    run["samples_per_pixel"] = r.scene.samples_per_pixel;
+    run["threads"] = r.threads;
+    run["image"] = relative(outputs.image);
+    if (!outputs.heatmap.empty()) run["heatmap"] = relative(outputs.heatmap);
+    nlohmann::ordered_json& config = doc["config"];
+    for (const timing::ConfigField& field : timing::config_fields(options.chip)) {
+        if (field.is_bool)
+            config[field.key] = field.value != 0;
+        else
+            config[field.key] = field.value;
+    }
+    doc["stats"] = stats::values_json(snapshot);
+    doc["units"] = stats::units_json(snapshot);
+    if (const std::vector<std::string> regions = region_names(snapshot); !regions.empty())
+        doc["regions"] = regions;
+    if (r.timing) doc["timeline"] = r.timing->timeline->json();
+    return doc;
 }
 
 }  // namespace tpsim::render

@@ -1,7 +1,12 @@
 // What a render reports: its statistics registered under hierarchical names
 // (docs/statistics.md), printed as text or JSON by the stats printers.
 #pragma once
+#include <filesystem>
 #include <iosfwd>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "render.hpp"
 #include "sim/stats/registry.hpp"
@@ -12,7 +17,32 @@ namespace tpsim::render {
 /// `result` must outlive every use of `registry`.
 void register_stats(const RenderResult& result, stats::Registry& registry);
 
-/// The human summary printed before the counters: scene, image sections, BVH, run.
+/// The human summary the report leads with: scene, kernel and chip (the configuration fields
+/// that differ from the defaults), memory image by section, BVH, rays, cycles, run speed.
 void print_summary(const RenderOptions& options, const RenderResult& result, std::ostream& out);
+
+/// The regions of the region/<r>/... statistics, in registration order (the table's rows).
+std::vector<std::string> region_names(const stats::Snapshot& snapshot);
+
+/// The compact traffic table: per region, L1 accesses and hit rate, L2 reads and hit rate, DRAM
+/// bytes read and written (whole lines of `line_bytes`) and the store payload they carried.
+void print_traffic(const stats::Snapshot& snapshot, uint32_t line_bytes, std::ostream& out);
+
+/// What a render wrote beside its statistics, named in the statistics file.
+struct OutputPaths {
+    std::filesystem::path image;    ///< the rendered image
+    std::filesystem::path heatmap;  ///< the heat-map PNG, or empty
+};
+
+/// The statistics file of a render (docs/statistics.md, "The statistics file"): run, config,
+/// `snapshot` as stats and units, regions, timeline and profile. Output paths are stored
+/// relative to the directory of `json_path`, so the files can move together.
+nlohmann::ordered_json stats_document(const RenderOptions& options, const RenderResult& result,
+                                      const stats::Snapshot& snapshot,
+                                      const std::filesystem::path& json_path,
+                                      const OutputPaths& outputs);
+
+/// The version of the statistics file this tpsim writes (and its analysis tools read).
+constexpr int kStatsFileVersion = 2;
 
 }  // namespace tpsim::render

@@ -3,34 +3,40 @@
 #include <algorithm>
 #include <cstring>
 
-#include "sim/core/elf_loader.hpp"
 
 namespace tpsim::render {
 
-std::shared_ptr<TimingRun> run_timing(const std::filesystem::path& kernel_elf,
-                                      image::MemoryImage& image, const timing::ChipConfig& chip,
-                                      uint64_t max_instructions, uint64_t pixels,
-                                      const ProgressCallback& on_progress) {
-    core::MachineConfig config = timing::machine_config_for(chip);
-    config.global_bytes = uint32_t(image.bytes());
-    config.read_only_global_bytes = uint32_t(image.read_only_bytes());
-    config.max_instructions = max_instructions;
-
+std::shared_ptr<TimingRun> run_timing(const core::Program& program, image::MemoryImage& image,
+                                      const timing::ChipConfig& chip,
+                                      const TimingRunOptions& options) {
     auto run = std::make_shared<TimingRun>();
-    run->machine = std::make_unique<core::Machine>(core::load_elf(kernel_elf), config);
+    run->machine = timing::make_machine(program, image.words, image.read_only_bytes(), chip,
+                                        options.max_instructions);
     core::Machine& machine = *run->machine;
-    std::memcpy(machine.memory().global().data(), image.words.data(), image.bytes());
     run->source = std::make_unique<timing::MachineSource>(machine);
     run->chip = std::make_unique<timing::Chip>(chip, *run->source, chip_layout(image, machine));
-
-    // Paused every kProgressInterval cycles for the progress report. Threads take one pixel
-    // past the end before they stop, hence the cap.
     timing::Chip& model = *run->chip;
+    stats::Registry chip_stats;
+    model.register_stats(chip_stats);
+    run->timeline = std::make_unique<Timeline>(
+        chip_stats, chip.chip.num_tms * chip.chip.tps_per_tm,
+        [&model] { return model.running_threads(); }, options.timeline_interval);
+    Timeline& timeline = *run->timeline;
+
+    // The chip pauses for each timeline sample and progress report. Threads take one pixel
+    // past the end before they stop, hence the cap.
     constexpr uint64_t kInterval = timing::Chip::kProgressInterval;
-    for (uint64_t until = kInterval; !model.run_until(until); until += kInterval)
-        if (on_progress)
-            on_progress({std::min<uint64_t>(machine.global_register(0), pixels), pixels,
-                         model.cycles()});
+    uint64_t next_report = kInterval;
+    while (!model.run_until(std::min(next_report, timeline.next_sample()))) {
+        if (model.cycles() == timeline.next_sample()) timeline.sample(model.cycles());
+        if (model.cycles() == next_report) {
+            next_report += kInterval;
+            if (options.on_progress)
+                options.on_progress({std::min<uint64_t>(machine.global_register(0), options.pixels),
+                                     options.pixels, model.cycles()});
+        }
+    }
+    timeline.sample(model.cycles());
     std::memcpy(image.words.data(), machine.memory().global().data(), image.bytes());
 
     run->instructions = InstructionCounts::of(machine.counters());

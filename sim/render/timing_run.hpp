@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "render.hpp"
+#include "timeline.hpp"
 #include "sim/core/machine.hpp"
 #include "kernel/memory_map.hpp"
 #include "sim/image/memory_image.hpp"
@@ -20,11 +21,12 @@ struct TimingRun {
     std::unique_ptr<core::Machine> machine;
     std::unique_ptr<timing::MachineSource> source;
     std::unique_ptr<timing::Chip> chip;
+    std::unique_ptr<Timeline> timeline;
     InstructionCounts instructions;
 };
 
-/// What the chip is told about a run: the image's non-empty sections as regions, the
-/// kernel's text, and one work item per pixel (per ray for a ray batch).
+/// What the chip is told about a run: the image's non-empty sections and the kernel's ELF
+/// segments as regions, the kernel's text, and one work item per pixel (per ray for a batch).
 inline timing::ChipLayout chip_layout(const image::MemoryImage& image,
                                       const core::Machine& machine) {
     timing::ChipLayout layout;
@@ -34,6 +36,10 @@ inline timing::ChipLayout chip_layout(const image::MemoryImage& image,
                                       uint32_t(trax::map::kGlobalBase + section.begin),
                                       uint32_t(trax::map::kGlobalBase + section.begin +
                                                section.bytes)});
+    // The kernel's own ELF image (constants in .rodata, .data, .bss): below the global memory.
+    const auto& segments = machine.program().segments;
+    if (!segments.empty())
+        layout.regions.push_back({"kernel_data", segments.front().vaddr, segments.back().end()});
     layout.text_base = machine.text_base();
     layout.text_words = machine.text_words();
     const auto& header = image.header;
@@ -42,12 +48,18 @@ inline timing::ChipLayout chip_layout(const image::MemoryImage& image,
     return layout;
 }
 
-/// Runs `kernel_elf` over `image` (in place) on the chip `chip`. `pixels` scales the progress
-/// reports, which come every timing::Chip::kProgressInterval cycles. Throws core::Fault on a
-/// guest fault and std::runtime_error on a timing deadlock.
-std::shared_ptr<TimingRun> run_timing(const std::filesystem::path& kernel_elf,
-                                      image::MemoryImage& image, const timing::ChipConfig& chip,
-                                      uint64_t max_instructions, uint64_t pixels = 0,
-                                      const ProgressCallback& on_progress = {});
+/// How a cycle-level run is watched while it runs.
+struct TimingRunOptions {
+    uint64_t max_instructions = uint64_t(1) << 32;  ///< per thread, for runaway kernels
+    uint64_t pixels = 0;           ///< scales the progress reports (0: none)
+    ProgressCallback on_progress;  ///< every timing::Chip::kProgressInterval cycles
+    uint64_t timeline_interval = 0;  ///< cycles between timeline samples; 0: adapt (Timeline)
+};
+
+/// Runs `program` over `image` (in place) on the chip `chip`. Throws core::Fault on a guest
+/// fault and std::runtime_error on a timing deadlock.
+std::shared_ptr<TimingRun> run_timing(const core::Program& program, image::MemoryImage& image,
+                                      const timing::ChipConfig& chip,
+                                      const TimingRunOptions& options = {});
 
 }  // namespace tpsim::render

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <ostream>
 #include <stdexcept>
 
@@ -23,29 +24,8 @@ bool valid_name(std::string_view name) {
 
 // Integers print exactly; reals with the shortest representation that round-trips, so the
 // output is identical for identical inputs on any host.
-std::string format_value(const Entry& e, bool json) {
-    if (e.is_integer()) return fmt::format("{}", e.integer());
-    const double v = e.real();
-    if (!std::isfinite(v)) return json ? "null" : fmt::format("{}", v);
-    return fmt::format("{}", v);
-}
-
-std::string json_escape(std::string_view s) {
-    std::string out;
-    for (char c : s) {
-        switch (c) {
-        case '"': out += "\\\""; break;
-        case '\\': out += "\\\\"; break;
-        case '\n': out += "\\n"; break;
-        case '\t': out += "\\t"; break;
-        default:
-            if (static_cast<unsigned char>(c) < 0x20)
-                out += fmt::format("\\u{:04x}", static_cast<unsigned>(c));
-            else
-                out += c;
-        }
-    }
-    return out;
+std::string format_value(const Value& v) {
+    return v.is_integer ? fmt::format("{}", v.integer) : fmt::format("{}", v.real);
 }
 
 }  // namespace
@@ -149,30 +129,75 @@ bool Registry::contains(std::string_view name) const {
                        [&](const Entry& e) { return e.name == name; });
 }
 
-void print_text(const Registry& registry, std::ostream& out) {
-    size_t name_width = 0, value_width = 0, unit_width = 0;
-    std::vector<std::string> values;
+Snapshot::Snapshot(const Registry& registry) {
+    values_.reserve(registry.entries().size());
     for (const Entry& e : registry.entries()) {
-        values.push_back(format_value(e, false));
-        name_width = std::max(name_width, e.name.size());
-        value_width = std::max(value_width, values.back().size());
-        unit_width = std::max(unit_width, e.unit.size());
-    }
-    for (size_t i = 0; i < values.size(); ++i) {
-        const Entry& e = registry.entries()[i];
-        out << fmt::format("{:<{}}  {:>{}} {:<{}}  # {}\n", e.name, name_width, values[i],
-                           value_width, e.unit, unit_width, e.description);
+        Value v{e.name, e.description, e.unit, e.is_integer()};
+        if (v.is_integer)
+            v.integer = e.integer();
+        else
+            v.real = e.real();
+        values_.push_back(std::move(v));
     }
 }
 
-void print_json(const Registry& registry, std::ostream& out) {
-    out << "{";
-    const char* separator = "\n";
-    for (const Entry& e : registry.entries()) {
-        out << separator << "  \"" << json_escape(e.name) << "\": " << format_value(e, true);
-        separator = ",\n";
+const Value& Snapshot::at(std::string_view name) const {
+    for (const Value& v : values_)
+        if (v.name == name) return v;
+    throw std::out_of_range(fmt::format("no statistic named '{}' in the snapshot", name));
+}
+
+Snapshot Snapshot::since(const Snapshot& earlier) const {
+    if (earlier.values_.size() != values_.size())
+        throw std::invalid_argument("Snapshot::since: the snapshots come from different registries");
+    Snapshot interval = *this;
+    for (size_t i = 0; i < values_.size(); ++i) {
+        Value& v = interval.values_[i];
+        if (earlier.values_[i].name != v.name)
+            throw std::invalid_argument(fmt::format(
+                "Snapshot::since: '{}' against '{}': different registries", v.name,
+                earlier.values_[i].name));
+        if (v.is_integer)
+            v.integer -= earlier.values_[i].integer;
+        else
+            v.real = std::numeric_limits<double>::quiet_NaN();
     }
-    out << "\n}\n";
+    return interval;
+}
+
+void print_text(const Snapshot& snapshot, std::ostream& out) {
+    size_t name_width = 0, value_width = 0, unit_width = 0;
+    std::vector<std::string> values;
+    for (const Value& v : snapshot.values()) {
+        values.push_back(format_value(v));
+        name_width = std::max(name_width, v.name.size());
+        value_width = std::max(value_width, values.back().size());
+        unit_width = std::max(unit_width, v.unit.size());
+    }
+    for (size_t i = 0; i < values.size(); ++i) {
+        const Value& v = snapshot.values()[i];
+        out << fmt::format("{:<{}}  {:>{}} {:<{}}  # {}\n", v.name, name_width, values[i],
+                           value_width, v.unit, unit_width, v.description);
+    }
+}
+
+nlohmann::ordered_json values_json(const Snapshot& snapshot) {
+    // nlohmann writes doubles in their shortest round-trip form and non-finite ones as null.
+    nlohmann::ordered_json values = nlohmann::ordered_json::object();
+    for (const Value& v : snapshot.values()) {
+        if (v.is_integer)
+            values[v.name] = v.integer;
+        else
+            values[v.name] = v.real;
+    }
+    return values;
+}
+
+nlohmann::ordered_json units_json(const Snapshot& snapshot) {
+    nlohmann::ordered_json units = nlohmann::ordered_json::object();
+    for (const Value& v : snapshot.values())
+        if (!v.unit.empty()) units[v.name] = v.unit;
+    return units;
 }
 
 }  // namespace tpsim::stats

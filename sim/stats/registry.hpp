@@ -1,6 +1,7 @@
 // Statistics registry: counters live as plain uint64_t fields inside the components that bump
 // them (no lookups at run time); they are registered once, by address, under hierarchical names
-// such as "tm3/l1/misses", and printed by separate printers (text, JSON).
+// such as "tm3/l1/misses". A Snapshot reads them all at one moment as plain values, which can
+// be subtracted (intervals) and are what the printers (text, JSON) and the analysis tools see.
 #pragma once
 #include <cstdint>
 #include <functional>
@@ -8,6 +9,8 @@
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 namespace tpsim::stats {
 
@@ -61,9 +64,42 @@ private:
 /// True when `name` matches `pattern` segment by segment ('*' matches one whole segment).
 bool matches(std::string_view pattern, std::string_view name);
 
-/// Aligned human-readable report: name, value, unit, description; one line per entry.
-void print_text(const Registry& registry, std::ostream& out);
-/// One flat JSON object {"name": value, ...} in registration order; non-finite values as null.
-void print_json(const Registry& registry, std::ostream& out);
+/// One statistic's value at one moment.
+struct Value {
+    std::string name, description, unit;
+    bool is_integer = false;
+    uint64_t integer = 0;  ///< when is_integer
+    double real = 0;       ///< otherwise
+
+    double value() const { return is_integer ? static_cast<double>(integer) : real; }
+};
+
+/// Every registered statistic read at one moment, in registration order.
+class Snapshot {
+public:
+    Snapshot() = default;
+    explicit Snapshot(const Registry& registry);
+
+    const std::vector<Value>& values() const { return values_; }
+    /// The value called `name`; throws std::out_of_range naming it if absent.
+    const Value& at(std::string_view name) const;
+    double value(std::string_view name) const { return at(name).value(); }
+
+    /// The interval from `earlier` to this snapshot of the same registry: integers (counters
+    /// and their sums) subtract; reals (ratios, rates, host times) are not additive and become
+    /// NaN, to be recomputed from the interval's counters by whoever needs them.
+    Snapshot since(const Snapshot& earlier) const;
+
+private:
+    std::vector<Value> values_;
+};
+
+/// Aligned human-readable report: name, value, unit, description; one line per value.
+void print_text(const Snapshot& snapshot, std::ostream& out);
+/// {"name": value, ...} in registration order: integers exact, reals in their shortest
+/// round-trip form, non-finite ones null (the "stats" object of the statistics file).
+nlohmann::ordered_json values_json(const Snapshot& snapshot);
+/// {"name": "unit", ...} for every value that has a unit (the "units" object).
+nlohmann::ordered_json units_json(const Snapshot& snapshot);
 
 }  // namespace tpsim::stats

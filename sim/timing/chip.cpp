@@ -325,6 +325,12 @@ bool Chip::run_cycles(uint64_t end) {
     return finished_;
 }
 
+uint32_t Chip::running_threads() const {
+    uint32_t running = 0;
+    for (const auto& tm : tms_) running += tm->running;
+    return running;
+}
+
 // Shared parts, in a fixed order: replies DRAM -> L2 -> L1, then requests L1 -> L2 -> DRAM
 // (so a request reaches DRAM in the cycle it leaves L2), then the global registers. TMs are
 // always visited in id order, each TM's queue in FIFO order.

@@ -67,6 +67,8 @@ public:
     uint64_t run(uint64_t max_cycles = UINT64_MAX);
 
     uint64_t cycles() const { return cycles_; }
+    /// Threads that have not exited yet.
+    uint32_t running_threads() const;
     const ChipLayout& layout() const { return layout_; }
     /// Each thread's cycles, issued instructions and DRAM bytes, charged to the work item it
     /// held (docs/statistics.md, "Work items"). Complete once the chip has finished; while

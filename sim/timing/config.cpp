@@ -277,13 +277,12 @@ std::string to_toml(const ChipConfig& config) {
     return out;
 }
 
-std::vector<std::string> config_keys() {
-    std::vector<std::string> keys;
-    const ChipConfig defaults;
-    for_each_field(defaults, [&](std::string_view name, const auto&, Range) {
-        keys.emplace_back(name);
+std::vector<ConfigField> config_fields(const ChipConfig& config) {
+    std::vector<ConfigField> fields;
+    for_each_field(config, [&](std::string_view name, const auto& field, Range) {
+        fields.push_back({std::string(name), uint32_t(field), kIsBool<decltype(field)>});
     });
-    return keys;
+    return fields;
 }
 
 }  // namespace tpsim::timing

@@ -143,7 +143,13 @@ void apply_override(ChipConfig& config, std::string_view assignment);
 void validate(const ChipConfig& config);
 /// The resolved configuration as TOML, every key present, with its allowed range as a comment.
 std::string to_toml(const ChipConfig& config);
-/// Every configurable key, in print order (for help text and tests).
-std::vector<std::string> config_keys();
+/// One configurable field's resolved value.
+struct ConfigField {
+    std::string key;  ///< e.g. "l1.size_bytes"
+    uint32_t value;   ///< 0 or 1 when is_bool
+    bool is_bool;
+};
+/// Every configurable field of `config`, in print order (statistics file, help text, tests).
+std::vector<ConfigField> config_fields(const ChipConfig& config);
 
 }  // namespace tpsim::timing

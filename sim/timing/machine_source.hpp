@@ -7,7 +7,10 @@
 #include "timing/chip.hpp"
 
 #include <array>
+#include <cstring>
 #include <exception>
+#include <memory>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -20,6 +23,23 @@ inline core::MachineConfig machine_config_for(const ChipConfig& chip) {
     config.threads_per_tm = chip.chip.tps_per_tm;
     config.local_store_bytes = chip.tp.local_store_bytes;
     return config;
+}
+
+/// The functional machine of a kernel run, with `global` (the memory image, of which the first
+/// `read_only_bytes` are read-only) in its global memory: the one place a run's machine is set
+/// up, for the functional engine, the cycle-level engine and their tests.
+inline std::unique_ptr<core::Machine> make_machine(const core::Program& program,
+                                                   std::span<const uint32_t> global,
+                                                   uint64_t read_only_bytes,
+                                                   const ChipConfig& chip,
+                                                   uint64_t max_instructions) {
+    core::MachineConfig config = machine_config_for(chip);
+    config.global_bytes = uint32_t(global.size_bytes());
+    config.read_only_global_bytes = uint32_t(read_only_bytes);
+    config.max_instructions = max_instructions;
+    auto machine = std::make_unique<core::Machine>(program, config);
+    std::memcpy(machine->memory().global().data(), global.data(), global.size_bytes());
+    return machine;
 }
 
 /// Runs each thread ahead of the chip: when the chip fetches an instruction of a thread with

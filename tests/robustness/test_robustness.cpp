@@ -128,7 +128,7 @@ Queries run_queries(const Mesh& mesh, const std::vector<Ray>& rays) {
     timing::ChipConfig chip;
     chip.chip.num_tms = 1;
     chip.chip.tps_per_tm = 4;
-    const std::filesystem::path kernel = std::filesystem::path(TPSIM_KERNEL_DIR) / "ray_query.elf";
+    const auto kernel = render::Kernel::load(std::filesystem::path(TPSIM_KERNEL_DIR) / "ray_query.elf");
     // A finite instruction budget: a ray that hung the traversal would fail the run.
     const uint64_t budget = 20000 * uint64_t(rays.size()) + 100000;
 

@@ -36,11 +36,9 @@ int main(int argc, char** argv) try {
     const uint32_t threads = chip.chip.num_tms * chip.chip.tps_per_tm;
     image::MemoryImage image = image::build_memory_image(scene, &bvh, threads);
 
-    core::MachineConfig config = timing::machine_config_for(chip);
-    config.global_bytes = uint32_t(image.bytes());
-    config.read_only_global_bytes = uint32_t(image.read_only_bytes());
-    core::Machine machine(core::load_elf(argv[2]), config);
-    std::memcpy(machine.memory().global().data(), image.words.data(), image.bytes());
+    const auto machine_ptr = timing::make_machine(core::load_elf(argv[2]), image.words,
+                                                  image.read_only_bytes(), chip, uint64_t(1) << 32);
+    core::Machine& machine = *machine_ptr;
     timing::MachineSource source(machine);
     timing::ChipLayout layout = render::chip_layout(image, machine);
     layout.profile = profile;
@@ -56,7 +54,7 @@ int main(int argc, char** argv) try {
         stats::Registry registry;
         model.register_stats(registry);
         std::ofstream json(argv[4]);
-        stats::print_json(registry, json);
+        json << stats::values_json(stats::Snapshot(registry)).dump(1) << "\n";
     }
     return 0;
 } catch (const std::exception& e) {

@@ -239,7 +239,7 @@ std::string run_mixed() {
     CHECK(stat(r, "dram/writes") == 16 * 40);
     CHECK(stat(r, "dram/reads") <= 97);  // each line read from DRAM at most once
     std::ostringstream json;
-    stats::print_json(r, json);
+    json << stats::values_json(stats::Snapshot(r)).dump(1);
     return json.str();
 }
 

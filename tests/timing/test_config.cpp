@@ -2,6 +2,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+
 using namespace tpsim::timing;
 using Catch::Contains;
 
@@ -73,10 +75,20 @@ TEST_CASE("the printed config lists every key and parses back to the same config
     apply_override(c, "fu.atomic.pipelined=false");
     apply_override(c, "l2.write_combining_lines=8");
     const std::string text = to_toml(c);
-    for (const std::string& key : config_keys()) {
-        const std::string leaf = key.substr(key.rfind('.') + 1);
+    const std::vector<ConfigField> fields = config_fields(c);
+    for (const ConfigField& field : fields) {
+        const std::string leaf = field.key.substr(field.key.rfind('.') + 1);
         CHECK(text.find(leaf) != std::string::npos);
     }
     CHECK(parse_config(text, "printed") == c);
-    CHECK(config_keys().size() == 4 + 4 + 9 * 3 + 2 + 2 * 6 + 1 + 15 + 3);
+    CHECK(fields.size() == 4 + 4 + 9 * 3 + 2 + 2 * 6 + 1 + 15 + 3);
+    // The fields carry the resolved values, bools as 0/1.
+    const auto field = [&](std::string_view key) {
+        return *std::find_if(fields.begin(), fields.end(),
+                             [&](const ConfigField& f) { return f.key == key; });
+    };
+    CHECK(field("dram.tCL").value == 20);
+    CHECK_FALSE(field("dram.tCL").is_bool);
+    CHECK(field("fu.atomic.pipelined").is_bool);
+    CHECK(field("fu.atomic.pipelined").value == 0);
 }

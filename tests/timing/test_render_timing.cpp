@@ -149,11 +149,10 @@ ChipRun run_chip(const timing::ChipConfig& chip, uint64_t pause_every = 0) {
     const scene::Bvh bvh = scene::build_bvh(scene.triangles, bvh_config);
     const image::MemoryImage image =
         image::build_memory_image(scene, &bvh, chip.chip.num_tms * chip.chip.tps_per_tm);
-    core::MachineConfig config = timing::machine_config_for(chip);
-    config.global_bytes = uint32_t(image.bytes());
-    config.read_only_global_bytes = uint32_t(image.read_only_bytes());
-    core::Machine machine(core::load_elf(TPSIM_KERNEL_DIR "/tracer.elf"), config);
-    std::memcpy(machine.memory().global().data(), image.words.data(), image.bytes());
+    const auto machine_ptr =
+        timing::make_machine(core::load_elf(TPSIM_KERNEL_DIR "/tracer.elf"), image.words,
+                             image.read_only_bytes(), chip, uint64_t(1) << 32);
+    core::Machine& machine = *machine_ptr;
     Source source(machine);
     timing::Chip model(chip, source);
     if (pause_every == 0)
