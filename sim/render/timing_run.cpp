@@ -14,7 +14,9 @@ std::shared_ptr<TimingRun> run_timing(const core::Program& program, image::Memor
                                         options.max_instructions);
     core::Machine& machine = *run->machine;
     run->source = std::make_unique<timing::MachineSource>(machine);
-    run->chip = std::make_unique<timing::Chip>(chip, *run->source, chip_layout(image, machine));
+    timing::ChipLayout layout = chip_layout(image, machine);
+    layout.profile = options.profile;
+    run->chip = std::make_unique<timing::Chip>(chip, *run->source, layout);
     timing::Chip& model = *run->chip;
     stats::Registry chip_stats;
     model.register_stats(chip_stats);
