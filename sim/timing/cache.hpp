@@ -4,8 +4,9 @@
 // Policy (docs/hardware-model.md): reads allocate; stores are write-around (as in TRaX): a store
 // is forwarded to the next level, never allocates, and leaves a present line valid; stores need
 // no reply. Optionally (the L2's write_combining_lines) stores merge in a small buffer of lines
-// and go on as one line write each. Each bank accepts one access per cycle; bank = line number % banks. Fills do not
-// occupy a bank. Data values are never stored: the functional core owns them.
+// and go on as one line write each. Each bank accepts one access per cycle; bank = line number
+// % banks. Fills do not occupy a bank. Data values are never stored: the functional core owns
+// them.
 #pragma once
 #include "stats/registry.hpp"
 #include "timing/bits.hpp"

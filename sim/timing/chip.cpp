@@ -423,7 +423,8 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
                                    : request.write                ? request.bytes
                                                                   : 0;
             count_access(tm.l1_traffic[request.region], outcome, request.bytes, moved);
-            if constexpr (kProfile) profile_at(request.pc).l1_misses += outcome == CacheOutcome::Miss;
+            if constexpr (kProfile)
+                profile_at(request.pc).l1_misses += outcome == CacheOutcome::Miss;
         }
         tm.mem_waiting_tps[part.w] &= ~part.back(accessed);
     });
@@ -577,8 +578,8 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             } else if (s.mem_bytes != 0) {
                 set_bit(tm.mem_waiting_tps, i);
                 tp.mem_at = ready;
-                tp.mem_request = {s.mem_address, i,     d.rd,   s.mem_store, region_of(s.mem_address),
-                                  s.mem_bytes,   s.pc, tp.item};
+                tp.mem_request = {s.mem_address, i, d.rd, s.mem_store,
+                                  region_of(s.mem_address), s.mem_bytes, s.pc, tp.item};
                 result_at = kNever;  // set by the L1 reply
             }
             if (d.rd != isa::kNoReg && !s.mem_store) {
@@ -596,7 +597,8 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
                 if (bubble != 0) {
                     counters.active_tp_cycles += bubble;
                     counters.stalls[size_t(Stall::Branch)] += bubble;
-                    if constexpr (kProfile) profile_at(s.pc).stalls[size_t(Stall::Branch)] += bubble;
+                    if constexpr (kProfile)
+                        profile_at(s.pc).stalls[size_t(Stall::Branch)] += bubble;
                     tm.sleep_until(i, now + 1 + bubble, now);
                 }
             }

@@ -24,7 +24,8 @@ int main(int argc, char** argv) try {
     argc -= profile;
     argv += profile;
     if (argc < 3) {
-        std::cerr << "usage: bench_timing [--profile] SCENE KERNEL_ELF [CONFIG.toml] [STATS.json]\n";
+        std::cerr << "usage: bench_timing [--profile] SCENE KERNEL_ELF [CONFIG.toml] "
+                     "[STATS.json]\n";
         return 2;
     }
     const timing::ChipConfig chip = argc > 3 ? timing::load_config(argv[3]) : timing::ChipConfig{};
