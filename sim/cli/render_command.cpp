@@ -12,6 +12,8 @@
 #include <unistd.h>
 
 #include "commands.hpp"
+#include "sim/analysis/html_report.hpp"
+#include "sim/analysis/stats_file.hpp"
 #include "sim/core/error.hpp"
 #include "sim/render/heatmap.hpp"
 #include "sim/render/image_file.hpp"
@@ -80,15 +82,6 @@ private:
     Clock::time_point start_, last_;
 };
 
-/// Throws unless the directory `path` would be written into exists.
-void check_directory_of(const std::filesystem::path& path, std::string_view what) {
-    const std::filesystem::path directory =
-        path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
-    if (std::error_code ec; !std::filesystem::is_directory(directory, ec))
-        throw Error(fmt::format("cannot write {} to '{}': directory '{}' does not exist", what,
-                                path.string(), directory.string()));
-}
-
 struct RenderCommandOptions {
     std::string scene;
     std::string output;
@@ -106,6 +99,7 @@ struct RenderCommandOptions {
     std::string annotate;
     std::string heatmap;
     std::string heatmap_metric = "cycles";
+    std::string html;
     uint64_t max_instructions = uint64_t(1) << 32;
 };
 
@@ -127,8 +121,11 @@ int run_render(const RenderCommandOptions& o) {
     const std::filesystem::path output =
         o.output.empty() ? std::filesystem::path(o.scene).stem().string() + ".png" : o.output;
     render::check_image_path(output);
-    if (!o.stats_json.empty()) check_directory_of(o.stats_json, "statistics");
-    if (!o.annotate.empty()) check_directory_of(o.annotate, "the annotated listing");
+    if (!o.stats_json.empty()) check_output_path(o.stats_json, "statistics");
+    if (!o.annotate.empty()) check_output_path(o.annotate, "the annotated listing");
+    if (!o.html.empty()) check_output_path(o.html, "the report");
+    // Read now, so a missing package is found before the run.
+    const std::string chart_js = o.html.empty() ? "" : analysis::load_chart_js();
     const render::HeatMetric heat_metric = render::parse_heat_metric(o.heatmap_metric);
     if (!o.heatmap.empty()) render::check_heatmap_path(o.heatmap);
     options.profile = o.profile || !o.annotate.empty();
@@ -176,21 +173,26 @@ int run_render(const RenderCommandOptions& o) {
         fmt::print("\n# chip configuration (resolved)\n{}\n", timing::to_toml(options.chip));
         stats::print_text(snapshot, std::cout);
     }
+    const render::OutputPaths outputs{output, o.heatmap};
     if (!o.stats_json.empty()) {
         const std::filesystem::path json_path = o.stats_json;
-        std::ofstream json(json_path);
-        json << render::stats_document(options, result, snapshot, json_path,
-                                       {output, o.heatmap})
-                    .dump(1)
-             << '\n';
-        if (!json) throw Error(fmt::format("cannot write statistics to '{}'", o.stats_json));
+        write_output(json_path,
+                     render::stats_document(options, result, snapshot, json_path, outputs).dump(1) +
+                         '\n',
+                     "statistics");
         // The configuration as a file the user can pass back with -c.
         const std::filesystem::path config_path =
             std::filesystem::path(o.stats_json).replace_extension(".config.toml");
-        std::ofstream config(config_path);
-        config << timing::to_toml(options.chip);
-        if (!config)
-            throw Error(fmt::format("cannot write the configuration to '{}'", config_path.string()));
+        write_output(config_path, timing::to_toml(options.chip), "the configuration");
+    }
+    if (!o.html.empty()) {
+        // The page is made from the statistics file, as `tpsim report` makes it.
+        const std::string document =
+            render::stats_document(options, result, snapshot, o.html, outputs).dump();
+        write_output(o.html,
+                     analysis::report_page(analysis::parse_stats_file(document, o.html), chart_js),
+                     "the report");
+        fmt::print("report   {}\n", o.html);
     }
     return 0;
 }
@@ -245,6 +247,9 @@ Command add_render_command(CLI::App& app) {
     command->add_option("--heatmap-metric", o->heatmap_metric,
                         "What the heat map shows: cycles, instructions or dram_bytes per pixel")
         ->capture_default_str();
+    command->add_option("--html", o->html,
+                        "Write a self-contained HTML report of the run here (as tpsim report "
+                        "makes from a statistics file)");
     command->add_option("--timeline-cycles", o->timeline_cycles,
                         "Cycles per row of the statistics file's timeline; 0: adapt to the run "
                         "(200-400 rows)")
