@@ -1,6 +1,7 @@
 #include "timeline.hpp"
 
 #include <algorithm>
+#include <limits>
 
 namespace tpsim::render {
 
@@ -16,6 +17,11 @@ constexpr uint64_t kFirstInterval = 1024;
 
 double ratio(uint64_t numerator, uint64_t denominator) {
     return denominator == 0 ? 0.0 : double(numerator) / double(denominator);
+}
+
+/// A hit rate is undefined for an interval without reads: NaN, written as null.
+double hit_rate(uint64_t hits, uint64_t reads) {
+    return reads == 0 ? std::numeric_limits<double>::quiet_NaN() : double(hits) / double(reads);
 }
 
 }  // namespace
@@ -62,7 +68,8 @@ nlohmann::ordered_json Timeline::json() const {
         if (cycles == 0) continue;
         const auto delta = [&](Counter c) { return b[c + 1] - a[c + 1]; };
         rows.push_back({b[0], ratio(delta(Instructions), cycles * threads_),
-                        ratio(delta(L1Hits), delta(L1Reads)), ratio(delta(L2Hits), delta(L2Reads)),
+                        hit_rate(delta(L1Hits), delta(L1Reads)),
+                        hit_rate(delta(L2Hits), delta(L2Reads)),
                         ratio(delta(DramRead) + delta(DramWritten), cycles),
                         b[Running + 1]});
     }
