@@ -78,8 +78,9 @@ public:
     /// ChipLayout::profile. Complete once finished, as work_items().
     const PcProfile& profile() const { return profile_; }
     /// Registers every counter under tm<i>/..., l2/<j>/..., dram/..., global_registers/...,
-    /// chip-wide sums under chip/... and traffic by region under region/... . The chip and
-    /// `registry` must outlive the printing.
+    /// chip-wide sums under chip/... and traffic by region under region/... (whose L1 figures
+    /// are summed over the TMs when run_until() returns). The chip and `registry` must outlive
+    /// the printing.
     void register_stats(stats::Registry& registry) const;
 
 private:
