@@ -96,7 +96,7 @@ struct Chart {
 
 /// The page being written: HTML body text plus the charts it places.
 class Page {
-  public:
+public:
     std::ostringstream body;
 
     /// Places a chart (nothing when it has no nonzero value: an empty chart says nothing).
@@ -131,7 +131,7 @@ class Page {
         return page.str();
     }
 
-  private:
+private:
     Json charts_ = Json::array();
 };
 

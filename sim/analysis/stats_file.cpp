@@ -21,7 +21,7 @@ struct TooDeep {};
 /// Reads one part of the document, naming where it is in messages: `X.json: "profile".
 /// "functions"[3]."cycles" must be a number, got a string`.
 class Reader {
-  public:
+public:
     explicit Reader(std::string file) : file_(std::move(file)) {}
 
     [[noreturn]] void fail(const std::string& where, const std::string& problem) const {
@@ -42,7 +42,7 @@ class Reader {
         return need(value, value.is_array(), "an array", where);
     }
 
-  private:
+private:
     const Json& need(const Json& value, bool ok, const char* expected,
                      const std::string& where) const {
         if (!ok) {

@@ -43,16 +43,17 @@ std::string grouped(double value) {
 }
 
 // Layout of the PNG, in pixels.
-constexpr uint32_t kMinWidth = 320;  ///< narrower maps are magnified, the legend needs room
-constexpr uint32_t kMaxMagnify = 16; ///< bounds the PNG of a tiny, oddly shaped image
-constexpr int kLegendHeight = 50;    ///< the strip below the map
-constexpr int kMargin = 10;          ///< around the bar, left and right
+constexpr uint32_t kMinWidth = 320;   ///< narrower maps are magnified, the legend needs room
+constexpr uint32_t kMaxMagnify = 16;  ///< bounds the PNG of a tiny, oddly shaped image
+constexpr int kLegendHeight = 50;     ///< the strip below the map
+constexpr int kMargin = 10;           ///< around the bar, left and right
 constexpr int kBarTop = 10, kBarHeight = 14, kTextBaseline = 42, kFontSize = 14;
-constexpr int kTextRow = 20, kTextGap = 12; ///< a second row of text; the least space between texts
+constexpr int kTextRow = 20,
+              kTextGap = 12;  ///< a second row of text; the least space between texts
 constexpr std::array<float, 3> kBackground = {0.10f, 0.10f, 0.11f};
 constexpr std::array<float, 3> kFrame = {0.55f, 0.55f, 0.55f};
 constexpr std::array<float, 3> kText = {0.92f, 0.92f, 0.92f};
-constexpr const char* kFont = "DejaVuSans"; // Debian fonts-dejavu-core
+constexpr const char* kFont = "DejaVuSans";  // Debian fonts-dejavu-core
 
 /// RGB float canvas, row 0 at the top.
 struct Canvas {
@@ -78,7 +79,7 @@ void write_buffer(OIIO::ImageBuf& buffer, const std::filesystem::path& path, OII
             fmt::format("cannot write heat map '{}': {}", path.string(), buffer.geterror()));
 }
 
-} // namespace
+}  // namespace
 
 std::string_view metric_name(HeatMetric metric) {
     return kMetricNames[size_t(metric)];
@@ -189,7 +190,7 @@ HeatmapFiles write_heatmap(const std::filesystem::path& png_path,
         }
 
     OIIO::ImageSpec png_spec(canvas.width, canvas.height, 3, OIIO::TypeDesc::FLOAT);
-    png_spec.attribute("oiio:ColorSpace", "sRGB"); // the colour map's values are sRGB-encoded
+    png_spec.attribute("oiio:ColorSpace", "sRGB");  // the colour map's values are sRGB-encoded
     png_spec.attribute("tpsim:metric", std::string(metric_name(metric)));
     OIIO::ImageBuf png(png_spec, canvas.rgb.data());
     const int baseline = map_height + kTextBaseline;
@@ -208,4 +209,4 @@ HeatmapFiles write_heatmap(const std::filesystem::path& png_path,
     return files;
 }
 
-} // namespace tpsim::render
+}  // namespace tpsim::render

@@ -49,4 +49,4 @@ HeatmapFiles write_heatmap(const std::filesystem::path& png_path,
                            const timing::WorkItemCosts& costs, uint32_t width, uint32_t height,
                            HeatMetric metric);
 
-} // namespace tpsim::render
+}  // namespace tpsim::render

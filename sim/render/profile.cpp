@@ -41,12 +41,12 @@ bool has_costs(const ProfileCosts& c) {
     return c != ProfileCosts{};
 }
 
-} // namespace
+}  // namespace
 
 Profile profile_of(const timing::PcProfile& words, const core::Program& program) {
     Profile profile;
     // Ordered maps: the roll-up must not depend on host hashing.
-    std::map<uint32_t, FunctionProfile> functions; // by symbol address; kUnknown at 0
+    std::map<uint32_t, FunctionProfile> functions;  // by symbol address; kUnknown at 0
     std::map<std::tuple<std::string, uint32_t, std::string>, LineProfile> lines;
     for (size_t index = 0; index < words.words.size(); ++index) {
         const ProfileCosts costs = costs_of(words.words[index]);
@@ -100,7 +100,7 @@ void put_costs(nlohmann::ordered_json& entry, const ProfileCosts& c) {
     entry["dram_bytes"] = c.dram_bytes;
 }
 
-} // namespace
+}  // namespace
 
 nlohmann::ordered_json profile_json(const Profile& profile) {
     nlohmann::ordered_json functions = nlohmann::ordered_json::array();
@@ -224,7 +224,7 @@ void print_table_head(std::ostream& out, const std::string& what) {
     fmt::print(out, " share cycles  execs fet brn  fu mem opd L1miss    DRAM  {}\n", what);
 }
 
-} // namespace
+}  // namespace
 
 void print_profile(const Profile& p, std::ostream& out) {
     const uint64_t total = p.total.cycles;
@@ -255,7 +255,7 @@ namespace {
 /// One source line's costs in the listing (all functions it appears in together).
 struct ListedLine {
     ProfileCosts costs;
-    size_t rank = 0; ///< 1 = hottest line of the profile; 0 = not among the ranked ones
+    size_t rank = 0;  ///< 1 = hottest line of the profile; 0 = not among the ranked ones
 };
 
 struct ListedFile {
@@ -272,7 +272,7 @@ constexpr size_t kContext = 3, kShortestCut = 3;
 std::vector<ListedFile> listed_files(const Profile& profile) {
     std::map<std::string, ListedFile> by_path;
     for (const LineProfile& l : profile.lines) {
-        if (l.path.empty()) continue; // kUnknown: no source to show
+        if (l.path.empty()) continue;  // kUnknown: no source to show
         ListedFile& file = by_path[l.path];
         file.path = l.path;
         file.costs += l.costs;
@@ -354,7 +354,7 @@ void write_file_section(std::ostream& out, const ListedFile& file, uint64_t tota
                    margin(&it->second, total), it->first);
 }
 
-} // namespace
+}  // namespace
 
 void write_annotated_listing(const std::filesystem::path& path, const Profile& profile,
                              const std::string& kernel) {
@@ -387,4 +387,4 @@ void write_annotated_listing(const std::filesystem::path& path, const Profile& p
                                 path.string()));
 }
 
-} // namespace tpsim::render
+}  // namespace tpsim::render

@@ -27,7 +27,7 @@ inline constexpr std::string_view kUnknown = "(unknown)";
 /// What an instruction word, a line or a function costs.
 struct ProfileCosts {
     uint64_t executions = 0;
-    uint64_t cycles = 0; ///< TP-cycles charged: executions + all stalls
+    uint64_t cycles = 0;  ///< TP-cycles charged: executions + all stalls
     std::array<uint64_t, timing::kStallCauses> stalls{};
     uint64_t l1_misses = 0;
     uint64_t dram_bytes = 0;
@@ -40,18 +40,18 @@ struct ProfileCosts {
 ProfileCosts costs_of(const timing::PcCounters& word);
 
 struct FunctionProfile {
-    std::string function; ///< demangled symbol name, or kUnknown
-    uint32_t address = 0; ///< the symbol's address; 0 for kUnknown
+    std::string function;  ///< demangled symbol name, or kUnknown
+    uint32_t address = 0;  ///< the symbol's address; 0 for kUnknown
     ProfileCosts costs;
 };
 
 /// A source line, charged with the words whose innermost line it is: code inlined into a caller
 /// counts on the inlined function's own line, as fault messages name it.
 struct LineProfile {
-    std::string file;     ///< file name (SourceLocation::file), or kUnknown
-    std::string path;     ///< full path from DWARF, for reading the source; "" for kUnknown
-    uint32_t line = 0;    ///< 0 for kUnknown
-    std::string function; ///< the function the line is in (Program::source_function_at)
+    std::string file;      ///< file name (SourceLocation::file), or kUnknown
+    std::string path;      ///< full path from DWARF, for reading the source; "" for kUnknown
+    uint32_t line = 0;     ///< 0 for kUnknown
+    std::string function;  ///< the function the line is in (Program::source_function_at)
     ProfileCosts costs;
 };
 
@@ -86,4 +86,4 @@ void write_annotated_listing(const std::filesystem::path& path, const Profile& p
 /// columns.
 std::string short_function_name(std::string_view demangled);
 
-} // namespace tpsim::render
+}  // namespace tpsim::render

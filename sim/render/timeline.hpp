@@ -18,12 +18,12 @@ public:
     static constexpr uint64_t kTargetRows = 200;
 
     /// Samples the chip counters registered in `chip_stats` (timing::Chip::register_stats) for
-    /// a chip of `threads` threads, and the threads still running (`running`). `interval` cycles between samples, or 0: adapt to the
-    /// run's length — start at 1024 cycles and, whenever 2 * kTargetRows samples are kept,
-    /// drop every other one and double the interval (the counters are cumulative, so merging
-    /// two intervals loses nothing but resolution).
-    Timeline(const stats::Registry& chip_stats, uint32_t threads,
-             std::function<uint64_t()> running, uint64_t interval = 0);
+    /// a chip of `threads` threads, and the threads still running (`running`). `interval` cycles
+    /// between samples, or 0: adapt to the run's length — start at 1024 cycles and, whenever 2 *
+    /// kTargetRows samples are kept, drop every other one and double the interval (the counters are
+    /// cumulative, so merging two intervals loses nothing but resolution).
+    Timeline(const stats::Registry& chip_stats, uint32_t threads, std::function<uint64_t()> running,
+             uint64_t interval = 0);
 
     /// The cycle at which the next sample is due.
     uint64_t next_sample() const { return next_; }
@@ -36,7 +36,7 @@ public:
 
 private:
     // The cumulative counters one row is computed from, in this order.
-    static constexpr size_t kCounters = 8;  // the last: threads running at the sample
+    static constexpr size_t kCounters = 8;              // the last: threads running at the sample
     using Point = std::array<uint64_t, kCounters + 1>;  // [0]: the cycle
 
     std::vector<stats::Entry> counters_;

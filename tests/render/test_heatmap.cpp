@@ -59,7 +59,7 @@ std::array<float, 3> as_bytes(const std::array<float, 3>& rgb) {
     return {std::round(rgb[0] * 255), std::round(rgb[1] * 255), std::round(rgb[2] * 255)};
 }
 
-} // namespace
+}  // namespace
 
 TEST_CASE("heat map: the EXR holds each pixel's metric exactly", "[heatmap]") {
     constexpr uint32_t w = 37, h = 23;
@@ -94,13 +94,13 @@ TEST_CASE("heat map: the EXR holds each pixel's metric exactly", "[heatmap]") {
 }
 
 TEST_CASE("heat map: the PNG maps the values to inferno with a legend below", "[heatmap]") {
-    constexpr uint32_t w = 100, h = 40; // 100 wide: magnified 4 times to 400
+    constexpr uint32_t w = 100, h = 40;  // 100 wide: magnified 4 times to 400
     timing::WorkItemCosts costs;
     for (uint32_t i = 0; i < w * h; ++i)
-        costs.items.push_back({uint64_t(10 + (i % w) * 10), 0, 0}); // 10 .. 1000 left to right
+        costs.items.push_back({uint64_t(10 + (i % w) * 10), 0, 0});  // 10 .. 1000 left to right
     const auto files =
         render::write_heatmap(scratch("ramp.png"), costs, w, h, render::HeatMetric::Cycles);
-    CHECK(files.legend_problem.empty()); // fonts-dejavu-core is installed by scripts/setup
+    CHECK(files.legend_problem.empty());  // fonts-dejavu-core is installed by scripts/setup
     const Pixels png = read(files.png);
     REQUIRE(png.channels == 3);
     CHECK(png.width == int(4 * w));
@@ -129,7 +129,7 @@ TEST_CASE("heat map: the PNG maps the values to inferno with a legend below", "[
     size_t text_pixels = 0;
     for (int y = brightest_row + 4; y < png.height; ++y)
         for (int x = 0; x < png.width; ++x)
-            text_pixels += png.at(x, y, 0) > 200 && png.at(x, y, 2) > 200; // white, not yellow
+            text_pixels += png.at(x, y, 0) > 200 && png.at(x, y, 2) > 200;  // white, not yellow
     CHECK(text_pixels > 100);
 
     // Numbers too wide to share a row with the label push it onto a row of its own.
@@ -171,7 +171,7 @@ TEST_CASE("heat map: inferno rises in lightness from black to yellow", "[heatmap
     const auto top = render::inferno(1);
     CHECK(top[0] > 0.95f);
     CHECK(top[1] > 0.95f);
-    CHECK(top[2] < 0.7f); // yellow, not white
+    CHECK(top[2] < 0.7f);  // yellow, not white
 }
 
 TEST_CASE("heat map: a bad metric or path is a clear error", "[heatmap]") {

@@ -83,7 +83,7 @@ std::string read_text(const std::filesystem::path& path) {
     return text.str();
 }
 
-} // namespace
+}  // namespace
 
 TEST_CASE("profile: function and line roll-ups add up to the totals exactly", "[profile]") {
     const timing::PcProfile words = synthetic_profile(tracer());
@@ -286,7 +286,7 @@ TEST_CASE("profile: the annotated listing shows lines with their shares", "[prof
     std::string text;
     for (uint32_t n = 0; n < hot.line; ++n)
         std::getline(source, text);
-    uint64_t line_cycles = 0; // the listing merges the functions a line is in
+    uint64_t line_cycles = 0;  // the listing merges the functions a line is in
     for (const render::LineProfile& l : p.lines)
         if (l.path == hot.path && l.line == hot.line) line_cycles += l.costs.cycles;
     const std::string share = fmt::format("{:6.2f}", 100.0 * line_cycles / p.total.cycles);
@@ -305,7 +305,7 @@ TEST_CASE("profile: the annotated listing shows lines with their shares", "[prof
     std::map<std::string, uint64_t> file_cycles;
     for (const render::LineProfile& l : p.lines)
         if (!l.path.empty()) file_cycles[l.path] += l.costs.cycles;
-    std::vector<std::pair<size_t, uint64_t>> sections; // (position in the listing, cycles)
+    std::vector<std::pair<size_t, uint64_t>> sections;  // (position in the listing, cycles)
     for (const auto& [file, cycles] : file_cycles) {
         const size_t at = listing.find("==== " + file + ":");
         REQUIRE(at != std::string::npos);

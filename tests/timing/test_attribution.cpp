@@ -90,7 +90,7 @@ void check_region_totals(const Chip& chip, const ChipConfig& config) {
     CHECK(s("region/instruction_fetch/icache/fetches") == s("chip/instructions"));
 }
 
-} // namespace
+}  // namespace
 
 TEST_CASE("traffic by region adds up to the chip's totals", "[attribution][regions]") {
     struct Case {
@@ -120,13 +120,13 @@ TEST_CASE("traffic by region adds up to the chip's totals", "[attribution][regio
         CHECK(s("region/bvh_nodes/l1/reads") > 0);
         CHECK(s("region/triangles/l1/reads") > 0);
         CHECK(s("region/bvh_nodes/l1/writes") == 0);
-        CHECK(s("region/local_store/local_store/payload_bytes") > 0); // the kernel's stack
+        CHECK(s("region/local_store/local_store/payload_bytes") > 0);  // the kernel's stack
     }
 }
 
 namespace {
 
-constexpr uint32_t kFramebuffer = 0x1000'1000; // programs/framebuffer.S
+constexpr uint32_t kFramebuffer = 0x1000'1000;  // programs/framebuffer.S
 constexpr uint32_t kPixels = 256;
 
 /// programs/framebuffer.S on `config`, with its framebuffer as the one region.
@@ -155,14 +155,14 @@ struct FramebufferRun {
     std::unique_ptr<Chip> chip;
 };
 
-} // namespace
+}  // namespace
 
 TEST_CASE("write-combining writes a framebuffer to DRAM once per line, write-around once per "
           "store",
           "[attribution][regions][write_combining]") {
     ChipConfig around = tiny();
     ChipConfig combining = around;
-    apply_override(combining, "l2.write_combining_lines=4"); // 4 TPs keep at most 3 lines open
+    apply_override(combining, "l2.write_combining_lines=4");  // 4 TPs keep at most 3 lines open
     const FramebufferRun a(around), c(combining);
     const Stats sa(*a.chip), sc(*c.chip);
     const uint64_t line = around.l2.line_bytes;
@@ -210,10 +210,10 @@ void check_work_item_totals(const Chip& chip) {
     CHECK(total.instructions == s("chip/instructions"));
     CHECK(total.dram_bytes == s("dram/bytes_read") + s("dram/bytes_written"));
     CHECK(total.cycles == s("chip/active_tp_cycles"));
-    CHECK(chip.work_items().unassigned.instructions > 0); // startup and the fetch past the end
+    CHECK(chip.work_items().unassigned.instructions > 0);  // startup and the fetch past the end
 }
 
-} // namespace
+}  // namespace
 
 TEST_CASE("costs by work item add up to the chip's totals", "[attribution][work_items]") {
     for (const ChipConfig& chip : {ChipConfig{}, tiny(), odd_chip()}) {
@@ -236,7 +236,7 @@ TEST_CASE("each framebuffer pixel costs its 12 instructions and, with write-arou
     REQUIRE(costs.items.size() == kPixels);
     check_work_item_totals(*run.chip);
     for (const WorkItemCounters& item : costs.items) {
-        REQUIRE(item.instructions == 12); // atominc, bge, 6 address and value ops, 3 sw, j
+        REQUIRE(item.instructions == 12);  // atominc, bge, 6 address and value ops, 3 sw, j
         REQUIRE(item.dram_bytes == 3 * 64);
     }
     CHECK(costs.unassigned.dram_bytes == 0);
@@ -272,7 +272,7 @@ struct ProfiledRun {
     std::unique_ptr<Chip> chip;
 };
 
-} // namespace
+}  // namespace
 
 TEST_CASE("the profile by instruction adds up to the chip's totals", "[attribution][profile]") {
     for (const ChipConfig& config : {ChipConfig{}, tiny(), odd_chip()}) {
