@@ -237,7 +237,7 @@ Command add_render_command(CLI::App& app) {
                       "(docs/statistics.md)");
     command->add_flag("--profile", o->profile,
                       "Profile the kernel by function and source line on the cycle-level chip "
-                      "(executions, stalls, L1 misses, DRAM bytes; about 10 % slower)");
+                      "(executions, stalls, L1 misses, DRAM bytes; about 11 % slower)");
     command->add_option("--annotate", o->annotate,
                         "Write the kernel's source annotated with its profile here (implies "
                         "--profile)");
