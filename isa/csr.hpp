@@ -62,4 +62,4 @@ constexpr bool is_read_only(uint32_t number) {
     return (number >> 10) == 3;
 }
 
-} // namespace tpsim::isa::csr
+}  // namespace tpsim::isa::csr

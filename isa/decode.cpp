@@ -58,7 +58,7 @@ int32_t immediate(uint32_t word, Format format, uint32_t mask) {
     return 0;
 }
 
-} // namespace
+}  // namespace
 
 Decoded decode(uint32_t word) {
     Decoded d;
@@ -83,4 +83,4 @@ Decoded decode(uint32_t word) {
     return d;
 }
 
-} // namespace tpsim::isa
+}  // namespace tpsim::isa

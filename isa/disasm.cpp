@@ -48,7 +48,7 @@ std::string fence_set(uint32_t set) {
     return s.empty() ? "0" : s;
 }
 
-} // namespace
+}  // namespace
 
 std::string disassemble(uint32_t word, uint32_t pc) {
     const Decoded d = decode(word);
@@ -75,7 +75,7 @@ std::string disassemble(uint32_t word, uint32_t pc) {
         break;
     case Format::I:
         operand(reg_name(d.rd));
-        if (d.rs1 == kNoReg) { // tp.atominc rd, imm
+        if (d.rs1 == kNoReg) {  // tp.atominc rd, imm
             operand(std::to_string(d.imm));
         } else if (insn.fu == FuClass::Load || d.op == Op::jalr) {
             operand(offset_base(d.rs1));
@@ -109,7 +109,7 @@ std::string disassemble(uint32_t word, uint32_t pc) {
         break;
     case Format::Fence:
         if (d.op != Op::fence) break;
-        if (uint32_t(d.imm) == 0x833) return "fence.tso"; // fm=1000, pred=succ=rw
+        if (uint32_t(d.imm) == 0x833) return "fence.tso";  // fm=1000, pred=succ=rw
         operand(fence_set(uint32_t(d.imm) >> 4 & 15));
         operand(fence_set(uint32_t(d.imm) & 15));
         break;
@@ -119,4 +119,4 @@ std::string disassemble(uint32_t word, uint32_t pc) {
     return text;
 }
 
-} // namespace tpsim::isa
+}  // namespace tpsim::isa

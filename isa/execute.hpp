@@ -105,7 +105,7 @@ bool csr_access(uint32_t number, uint32_t source, CsrWrite kind, bool writes, ui
         old = uint32_t(h.instret >> 32);
         if (writes) h.instret = uint64_t{combine(old)} << 32 | uint32_t(h.instret);
         return true;
-    case csr::kMisa: // WARL: writes are ignored
+    case csr::kMisa:  // WARL: writes are ignored
         old = kMisa;
         return true;
     case csr::kMvendorid:
@@ -125,7 +125,7 @@ bool csr_access(uint32_t number, uint32_t source, CsrWrite kind, bool writes, ui
     return !writes && env.read_csr(number, old);
 }
 
-} // namespace detail
+}  // namespace detail
 
 /// Executes one pre-decoded instruction (contract in hart.hpp).
 template <class Env> inline void execute(const Decoded& d, Hart& h, Env& env) {
@@ -196,4 +196,4 @@ template <class Env> inline void execute(const Decoded& d, Hart& h, Env& env) {
     ++h.instret;
 }
 
-} // namespace tpsim::isa
+}  // namespace tpsim::isa

@@ -57,9 +57,9 @@ uint32_t round_ties_away(float truncated, uint32_t truncated_flags, double exact
                          uint32_t& fflags) {
     uint32_t bits = std::bit_cast<uint32_t>(truncated);
     if ((truncated_flags & NX) && std::isfinite(truncated)) {
-        const uint32_t away = bits + 1; // next magnitude up; FLT_MAX + 1 ulp is +-inf
+        const uint32_t away = bits + 1;  // next magnitude up; FLT_MAX + 1 ulp is +-inf
         const double midpoint = (away & 0x7fff'ffff) == 0x7f80'0000
-                                    ? 0x1.ffffffp+127 // halfway between FLT_MAX and 2^128
+                                    ? 0x1.ffffffp+127  // halfway between FLT_MAX and 2^128
                                     : (double(truncated) + double(std::bit_cast<float>(away))) / 2;
         if (std::fabs(exact_rtz) >= std::fabs(midpoint)) {
             bits = away;
@@ -99,7 +99,7 @@ template <class Op> uint32_t binary(uint32_t a, uint32_t b, unsigned rm, uint32_
         [&] { return op(opaque(double(x)), opaque(double(y))); });
 }
 
-} // namespace
+}  // namespace
 
 uint32_t reference::add(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags) {
     return binary(a, b, rm, fflags, [](auto x, auto y) { return x + y; });
@@ -154,7 +154,7 @@ uint32_t nearest(float result, bool inexact, uint32_t& fflags) {
     return std::bit_cast<uint32_t>(result);
 }
 
-} // namespace
+}  // namespace
 
 // RNE fast paths. The host MXCSR is at its default whenever fpu code runs (run_rounded leaves it
 // there), so plain host arithmetic already rounds RNE; when flags_at_most_nx holds, NX is decided
@@ -249,7 +249,7 @@ double round_to_integer(float value, unsigned rm, bool& inexact) {
         return fraction > 0 ? truncated + 1 : truncated;
     case RMM:
         return std::fabs(fraction) >= 0.5 ? away : truncated;
-    default: // RNE
+    default:  // RNE
         if (std::fabs(fraction) > 0.5) return away;
         if (std::fabs(fraction) < 0.5) return truncated;
         return std::fmod(truncated, 2) == 0 ? truncated : away;
@@ -270,7 +270,7 @@ uint32_t convert_to_integer(uint32_t a, unsigned rm, uint32_t& fflags, double lo
     return uint32_t(int64_t(r));
 }
 
-} // namespace
+}  // namespace
 
 uint32_t cvt_w_s(uint32_t a, unsigned rm, uint32_t& fflags) {
     return convert_to_integer(a, rm, fflags, -2147483648.0, 2147483647.0, 0x7fff'ffff);
@@ -280,4 +280,4 @@ uint32_t cvt_wu_s(uint32_t a, unsigned rm, uint32_t& fflags) {
     return convert_to_integer(a, rm, fflags, 0.0, 4294967295.0, 0xffff'ffff);
 }
 
-} // namespace tpsim::isa::fpu
+}  // namespace tpsim::isa::fpu

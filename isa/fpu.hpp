@@ -34,7 +34,7 @@ uint32_t mul(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags);
 uint32_t div(uint32_t a, uint32_t b, unsigned rm, uint32_t& fflags);
 uint32_t sqrt(uint32_t a, unsigned rm, uint32_t& fflags);
 uint32_t fma(uint32_t a, uint32_t b, uint32_t c, unsigned rm, uint32_t& fflags);
-} // namespace reference
+}  // namespace reference
 uint32_t cvt_s_w(int32_t a, unsigned rm, uint32_t& fflags);
 uint32_t cvt_s_wu(uint32_t a, unsigned rm, uint32_t& fflags);
 /// Float to integer: rounds per rm, saturates out-of-range values (NaN -> largest) with NV.
@@ -112,4 +112,4 @@ constexpr uint32_t classify(uint32_t a) {
     return negative ? 1u << 1 : 1u << 6;
 }
 
-} // namespace tpsim::isa::fpu
+}  // namespace tpsim::isa::fpu

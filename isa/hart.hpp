@@ -8,13 +8,13 @@ namespace tpsim::isa {
 struct Hart {
     uint32_t reg[kNumRegs] = {};  ///< unified file (see isa.hpp); reg[0] is always 0
     uint32_t pc = 0;
-    uint32_t fflags = 0;          ///< accrued exception flags NV|DZ|OF|UF|NX (bits 4..0)
-    uint32_t frm = 0;             ///< dynamic rounding mode
+    uint32_t fflags = 0;  ///< accrued exception flags NV|DZ|OF|UF|NX (bits 4..0)
+    uint32_t frm = 0;     ///< dynamic rounding mode
     uint32_t mstatus = 0, mtvec = 0, mepc = 0, mcause = 0, mtval = 0, mscratch = 0;
     uint32_t mie = 0, mip = 0;
     uint64_t instret = 0;
 
-    float f(unsigned i) const;    ///< f-register i as a float
+    float f(unsigned i) const;  ///< f-register i as a float
 };
 
 /// Sets the trap CSRs and jumps to mtvec (direct mode), as a machine-mode trap does.

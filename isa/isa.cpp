@@ -58,4 +58,4 @@ float Hart::f(unsigned i) const {
     return std::bit_cast<float>(reg[kFpBase + i]);
 }
 
-} // namespace tpsim::isa
+}  // namespace tpsim::isa

@@ -22,19 +22,19 @@ enum class Format : uint8_t { R, R4, I, S, B, U, J, Csr, CsrImm, Fence, System }
 
 /// The functional-unit class that executes an instruction: the timing model keys on this only.
 enum class FuClass : uint8_t {
-    IntAlu,   ///< add, logic, shifts, compares, lui/auipc
-    IntMul,   ///< mul, mulh*
-    IntDiv,   ///< div*, rem*
-    FpAdd,    ///< fadd, fsub
-    FpMul,    ///< fmul, fused multiply-add family
-    FpDiv,    ///< fdiv
-    FpSqrt,   ///< fsqrt
-    FpMisc,   ///< compare, min/max, sign injection, classify, move, convert
-    Branch,   ///< conditional branches and jumps
-    Load,     ///< lw/lh/lb/flw ...
-    Store,    ///< sw/sh/sb/fsw ...
-    Atomic,   ///< global-register atomics (tpsim custom extension)
-    System,   ///< csr*, fence*, ecall, ebreak, mret
+    IntAlu,  ///< add, logic, shifts, compares, lui/auipc
+    IntMul,  ///< mul, mulh*
+    IntDiv,  ///< div*, rem*
+    FpAdd,   ///< fadd, fsub
+    FpMul,   ///< fmul, fused multiply-add family
+    FpDiv,   ///< fdiv
+    FpSqrt,  ///< fsqrt
+    FpMisc,  ///< compare, min/max, sign injection, classify, move, convert
+    Branch,  ///< conditional branches and jumps
+    Load,    ///< lw/lh/lb/flw ...
+    Store,   ///< sw/sh/sb/fsw ...
+    Atomic,  ///< global-register atomics (tpsim custom extension)
+    System,  ///< csr*, fence*, ecall, ebreak, mret
     Count
 };
 
@@ -56,11 +56,11 @@ struct Decoded {
     uint8_t rs1 = kNoReg;  ///< unified index; kNoReg if not read
     uint8_t rs2 = kNoReg;
     uint8_t rs3 = kNoReg;
-    uint8_t rm = 0;        ///< FP rounding-mode field (7 = dynamic)
-    uint8_t zimm = 0;      ///< 5-bit unsigned immediate of csrrwi/csrrsi/csrrci
+    uint8_t rm = 0;                ///< FP rounding-mode field (7 = dynamic)
+    uint8_t zimm = 0;              ///< 5-bit unsigned immediate of csrrwi/csrrsi/csrrci
     FuClass fu = FuClass::System;  ///< info(op).fu, here so the timing model reads it per issue
-    int32_t imm = 0;       ///< sign-extended immediate; CSR number for Zicsr; shamt for shifts;
-                           ///< fm|pred|succ for fence
+    int32_t imm = 0;  ///< sign-extended immediate; CSR number for Zicsr; shamt for shifts;
+                      ///< fm|pred|succ for fence
 };
 
 /// Which register file an operand field names.
@@ -74,7 +74,9 @@ struct OperandInfo {
 
 /// Parses the table's 4-character operand spec ("fffr", "xf--", ...; see instructions.def).
 constexpr OperandInfo operand_info(std::string_view spec) {
-    auto kind = [](char c) { return c == 'x' ? RegKind::Int : c == 'f' ? RegKind::Fp : RegKind::None; };
+    auto kind = [](char c) {
+        return c == 'x' ? RegKind::Int : c == 'f' ? RegKind::Fp : RegKind::None;
+    };
     return {kind(spec[0]), kind(spec[1]), kind(spec[2]), spec[3] == 'r'};
 }
 

@@ -16,8 +16,8 @@ typedef struct TraxNativeContext {
     uint32_t num_threads;       /**< trax_main() runs once per thread id, in order 0..n-1 */
     uint32_t num_tms;           /**< thread i is in TM i / tm_size, at index i % tm_size */
     uint32_t tm_size;
-    char* error;                /**< receives a one-line message when the run fails */
-    uint32_t error_capacity;    /**< bytes at error, including the terminating NUL */
+    char* error;             /**< receives a one-line message when the run fails */
+    uint32_t error_capacity; /**< bytes at error, including the terminating NUL */
 } TraxNativeContext;
 
 /** Runs the kernel; global registers start at 0. Returns 0 on success, nonzero after writing

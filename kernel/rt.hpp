@@ -13,19 +13,33 @@ using namespace trax::layout;
 struct Vec3 {
     float x, y, z;
 };
-inline Vec3 operator+(Vec3 a, Vec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-inline Vec3 operator-(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-inline Vec3 operator*(Vec3 a, float s) { return {a.x * s, a.y * s, a.z * s}; }
-inline Vec3 operator*(Vec3 a, Vec3 b) { return {a.x * b.x, a.y * b.y, a.z * b.z}; }
-inline float dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline Vec3 operator+(Vec3 a, Vec3 b) {
+    return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+inline Vec3 operator-(Vec3 a, Vec3 b) {
+    return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+inline Vec3 operator*(Vec3 a, float s) {
+    return {a.x * s, a.y * s, a.z * s};
+}
+inline Vec3 operator*(Vec3 a, Vec3 b) {
+    return {a.x * b.x, a.y * b.y, a.z * b.z};
+}
+inline float dot(Vec3 a, Vec3 b) {
+    return a.x * b.x + a.y * b.y + a.z * b.z;
+}
 inline Vec3 cross(Vec3 a, Vec3 b) {
     return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
 inline Vec3 load_vec3(int addr, int offset) {
     return {loadf(addr, offset), loadf(addr, offset + 1), loadf(addr, offset + 2)};
 }
-inline float component(Vec3 v, int axis) { return axis == 0 ? v.x : axis == 1 ? v.y : v.z; }
-inline bool is_nan(float x) { return x != x; }
+inline float component(Vec3 v, int axis) {
+    return axis == 0 ? v.x : axis == 1 ? v.y : v.z;
+}
+inline bool is_nan(float x) {
+    return x != x;
+}
 
 /// A ray prepared for the watertight test of Woop, Benthin and Wald, "Watertight Ray/Triangle
 /// Intersection", JCGT 2(1), 2013: axes permuted so the direction's largest component is z, and
@@ -65,8 +79,8 @@ inline ShearedRay shear(Vec3 origin, Vec3 dir) {
 /// triangles. Degenerate triangles have det == 0 and never hit. Every comparison that accepts
 /// is written so that a NaN (from a NaN or infinite ray) rejects.
 /// Always inlined into the loops so the ray stays in registers across triangles.
-[[gnu::always_inline]] inline bool intersect(const ShearedRay& r, int tri, float t_min,
-                                            float t_max, float& t) {
+[[gnu::always_inline]] inline bool intersect(const ShearedRay& r, int tri, float t_min, float t_max,
+                                             float& t) {
     // Vertices relative to the origin, sheared and scaled. One address per permuted axis, so
     // the three vertices' coordinates on it are constant offsets from it (one flw each).
     const int x = tri + r.kx, y = tri + r.ky, z = tri + r.kz;
@@ -138,8 +152,10 @@ struct ThreadTotals {
     uint32_t max_stack_depth = 0, stack_overflows = 0;
 
     void add(const RayStats& ray, bool shadow) {
-        if (shadow) ++shadow_rays;
-        else ++primary_rays;
+        if (shadow)
+            ++shadow_rays;
+        else
+            ++primary_rays;
         nodes_visited += ray.nodes_visited;
         triangles_tested += ray.triangles_tested;
         if (ray.max_stack_depth > max_stack_depth) max_stack_depth = ray.max_stack_depth;
@@ -182,8 +198,7 @@ struct BruteForce {
 
     static BruteForce from_scene() { return {trax_triangles(), trax_num_triangles()}; }
 
-    template <bool kAnyHit>
-    Hit trace(Vec3 origin, Vec3 dir, float t_max, RayStats& stats) const {
+    template <bool kAnyHit> Hit trace(Vec3 origin, Vec3 dir, float t_max, RayStats& stats) const {
         Hit hit;
         hit.t = t_max;
         if (!valid_ray(origin, dir, t_max)) return hit;
@@ -230,15 +245,15 @@ struct BruteForce {
 /// Stack-based BVH traversal over the image's BVH (scene_layout.hpp BvhNode): nearer child
 /// first, far child pushed with its entry distance, popped subtrees beyond the closest hit
 /// skipped, any-hit rays stop at the first hit. Stack capacity: kTraversalStackEntries
-/// (scene_layout.hpp), which matches the scene builder's depth contract. A full stack is counted, never silent: the far
-/// child is then dropped (the hit may be missed) and the host reports the overflow as an error.
+/// (scene_layout.hpp), which matches the scene builder's depth contract. A full stack is counted,
+/// never silent: the far child is then dropped (the hit may be missed) and the host reports the
+/// overflow as an error.
 struct BvhTraversal {
     int nodes, triangles;
 
     static BvhTraversal from_scene() { return {trax_bvh(), trax_triangles()}; }
 
-    template <bool kAnyHit>
-    Hit trace(Vec3 origin, Vec3 dir, float t_max, RayStats& stats) const {
+    template <bool kAnyHit> Hit trace(Vec3 origin, Vec3 dir, float t_max, RayStats& stats) const {
         Hit hit;
         hit.t = t_max;
         if (!valid_ray(origin, dir, t_max)) return hit;
@@ -342,8 +357,8 @@ Vec3 shade(const Shading& s, const Accel& accel, Vec3 origin, Vec3 dir, ThreadTo
     const int tri = s.triangles + hit.triangle * kTriangleWords;
     const Vec3 n = facing_normal(tri, dir);
     const Vec3 p = origin + dir * hit.t;
-    const Vec3 albedo = load_vec3(s.materials + loadi(tri, kTriangleMaterial) * kMaterialWords,
-                                  kMaterialDiffuse);
+    const Vec3 albedo =
+        load_vec3(s.materials + loadi(tri, kTriangleMaterial) * kMaterialWords, kMaterialDiffuse);
 
     Vec3 light_sum = s.ambient;
     for (int i = 0; i < s.num_lights; ++i) {
@@ -384,8 +399,7 @@ inline float unit_float(uint32_t bits) {
 /// The whole render kernel: pixels handed out with atomicinc(0); each gets samples_per_pixel
 /// camera rays (pixel centre for one sample, hashed jitter for more), shaded and averaged into
 /// the framebuffer as linear RGB; the thread's statistics record is written at the end.
-template <class Accel>
-void render_image(const Accel& accel) {
+template <class Accel> void render_image(const Accel& accel) {
     const Shading s = Shading::from_scene();
     const int width = trax_image_width(), height = trax_image_height();
     const int samples = trax_samples_per_pixel();

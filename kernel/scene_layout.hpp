@@ -26,8 +26,8 @@ constexpr const char* kUsesBvhSymbol = "trax_uses_bvh";
 
 /// Feature flags in SceneHeader::flags: rendering choices the scene file makes.
 enum Feature : uint32_t {
-    kFeatureShadows = 1u << 0,          ///< cast a shadow ray to every light
-    kFeatureLightFalloff = 1u << 1,     ///< divide light intensity by squared distance
+    kFeatureShadows = 1u << 0,       ///< cast a shadow ray to every light
+    kFeatureLightFalloff = 1u << 1,  ///< divide light intensity by squared distance
 };
 
 /// Where a section lives: word address (relative to kGlobalBase) and number of records.
@@ -89,16 +89,17 @@ struct SceneHeader {
     int32_t image_width;
     int32_t image_height;
     int32_t samples_per_pixel;
-    uint32_t flags;        ///< Feature bits
-    int32_t total_words;   ///< size of the whole image, framebuffer included
-    float ambient[3];      ///< ambient light, multiplied by the diffuse albedo
-    float background[3];   ///< colour of rays that hit nothing
-    SectionRef camera;     ///< count 1
+    uint32_t flags;       ///< Feature bits
+    int32_t total_words;  ///< size of the whole image, framebuffer included
+    float ambient[3];     ///< ambient light, multiplied by the diffuse albedo
+    float background[3];  ///< colour of rays that hit nothing
+    SectionRef camera;    ///< count 1
     SectionRef lights;
     SectionRef materials;
     SectionRef triangles;
     SectionRef bvh_nodes;  ///< count 0 when the scene has no BVH
-    SectionRef framebuffer;  ///< count = width * height pixels, 3 floats (linear RGB) each, row 0 = top
+    SectionRef
+        framebuffer;  ///< count = width * height pixels, 3 floats (linear RGB) each, row 0 = top
     SectionRef thread_stats;  ///< one ThreadStats per hardware thread, written by the kernel
     SectionRef rays;          ///< ray_query input batch (count 0 for renders)
     SectionRef ray_results;   ///< ray_query output, one RayResult per ray
@@ -114,8 +115,8 @@ struct ThreadStats {
     uint32_t nodes_visited_hi;
     uint32_t triangles_tested_lo;  ///< ray/triangle tests, summed over rays
     uint32_t triangles_tested_hi;
-    uint32_t max_stack_depth;   ///< most traversal-stack entries in use at once
-    uint32_t stack_overflows;   ///< pushes refused because the stack was full (must stay 0)
+    uint32_t max_stack_depth;  ///< most traversal-stack entries in use at once
+    uint32_t stack_overflows;  ///< pushes refused because the stack was full (must stay 0)
 };
 
 /// Query modes of a Ray (bits).
@@ -169,7 +170,7 @@ enum HeaderWord : int32_t {
     kHeaderTotalWords = 6,
     kHeaderAmbient = 7,
     kHeaderBackground = 10,
-    kHeaderCamera = 13,       ///< SectionRef: +0 addr, +1 count
+    kHeaderCamera = 13,  ///< SectionRef: +0 addr, +1 count
     kHeaderLights = 15,
     kHeaderMaterials = 17,
     kHeaderTriangles = 19,
@@ -182,16 +183,38 @@ enum HeaderWord : int32_t {
 
 /// Word offsets of record fields, for loadf(record_addr, kTri...) in kernels.
 enum RecordWord : int32_t {
-    kCameraEye = 0, kCameraCorner = 3, kCameraRight = 6, kCameraDown = 9,
-    kLightPosition = 0, kLightColor = 3,
+    kCameraEye = 0,
+    kCameraCorner = 3,
+    kCameraRight = 6,
+    kCameraDown = 9,
+    kLightPosition = 0,
+    kLightColor = 3,
     kMaterialDiffuse = 0,
-    kTriangleV0 = 0, kTriangleV1 = 3, kTriangleV2 = 6, kTriangleMaterial = 9,
-    kNodeMin = 0, kNodeMax = 3, kNodeFirst = 6, kNodeCount = 7,
-    kStatsPrimaryRays = 0, kStatsShadowRays = 1, kStatsNodesVisited = 2,
-    kStatsTrianglesTested = 4, kStatsMaxStackDepth = 6, kStatsStackOverflows = 7,
-    kRayOrigin = 0, kRayDirection = 3, kRayTMax = 6, kRayMode = 7, kRaySurfaceTriangle = 8,
-    kResultTriangle = 0, kResultT = 1, kResultNodesVisited = 2, kResultTrianglesTested = 3,
-    kResultMaxStackDepth = 4, kResultStackOverflows = 5,
+    kTriangleV0 = 0,
+    kTriangleV1 = 3,
+    kTriangleV2 = 6,
+    kTriangleMaterial = 9,
+    kNodeMin = 0,
+    kNodeMax = 3,
+    kNodeFirst = 6,
+    kNodeCount = 7,
+    kStatsPrimaryRays = 0,
+    kStatsShadowRays = 1,
+    kStatsNodesVisited = 2,
+    kStatsTrianglesTested = 4,
+    kStatsMaxStackDepth = 6,
+    kStatsStackOverflows = 7,
+    kRayOrigin = 0,
+    kRayDirection = 3,
+    kRayTMax = 6,
+    kRayMode = 7,
+    kRaySurfaceTriangle = 8,
+    kResultTriangle = 0,
+    kResultT = 1,
+    kResultNodesVisited = 2,
+    kResultTrianglesTested = 3,
+    kResultMaxStackDepth = 4,
+    kResultStackOverflows = 5,
 };
 
 // The enums above and the structs must agree, and every record must be whole words: a kernel
@@ -269,7 +292,8 @@ constexpr int32_t align_section(int32_t word) {
 /// camera, lights, materials, triangles, bvh_nodes, framebuffer, thread_stats, rays,
 /// ray_results, each aligned to
 /// kSectionAlignWords; empty sections take no space. The framebuffer count is set from the
-/// image size, the ray_results count from the rays count. The scene compiler calls this; tests check images against it.
+/// image size, the ray_results count from the rays count. The scene compiler calls this; tests
+/// check images against it.
 constexpr void place_sections(SceneHeader& h) {
     h.camera.count = 1;
     h.framebuffer.count = h.image_width * h.image_height;
@@ -279,10 +303,14 @@ constexpr void place_sections(SceneHeader& h) {
         int32_t record_words;
     };
     const Section order[] = {
-        {&h.camera, kCameraWords},       {&h.lights, kPointLightWords},
-        {&h.materials, kMaterialWords},  {&h.triangles, kTriangleWords},
-        {&h.bvh_nodes, kBvhNodeWords},   {&h.framebuffer, kPixelWords},
-        {&h.thread_stats, kThreadStatsWords}, {&h.rays, kRayWords},
+        {&h.camera, kCameraWords},
+        {&h.lights, kPointLightWords},
+        {&h.materials, kMaterialWords},
+        {&h.triangles, kTriangleWords},
+        {&h.bvh_nodes, kBvhNodeWords},
+        {&h.framebuffer, kPixelWords},
+        {&h.thread_stats, kThreadStatsWords},
+        {&h.rays, kRayWords},
         {&h.ray_results, kRayResultWords},
     };
     int32_t next = align_section(kHeaderWords);

@@ -3,4 +3,6 @@
 // so the memory image holds no BVH.
 #include "rt.hpp"
 
-void trax_main() { trax::rt::render_image(trax::rt::BruteForce::from_scene()); }
+void trax_main() {
+    trax::rt::render_image(trax::rt::BruteForce::from_scene());
+}

@@ -5,4 +5,6 @@
 
 TRAX_USES_BVH;
 
-void trax_main() { trax::rt::render_image(trax::rt::BvhTraversal::from_scene()); }
+void trax_main() {
+    trax::rt::render_image(trax::rt::BvhTraversal::from_scene());
+}

@@ -31,7 +31,8 @@ std::string check(const TraxNativeContext& ctx) {
 
 }  // namespace
 
-extern "C" __attribute__((visibility("default"))) int tpsim_native_run(const TraxNativeContext* ctx) {
+extern "C" __attribute__((visibility("default"))) int
+tpsim_native_run(const TraxNativeContext* ctx) {
     if (ctx == nullptr) return 1;
     if (const std::string problem = check(*ctx); !problem.empty()) {
         report(*ctx, problem);
@@ -49,9 +50,9 @@ extern "C" __attribute__((visibility("default"))) int tpsim_native_run(const Tra
     // read-only as on the simulator.
     if (ctx->global_word_count >= sizeof(trax::layout::SceneHeader) / 4 &&
         ctx->global_words[trax::layout::kHeaderMagic] == trax::layout::kMagic)
-        thread.read_only_words = std::clamp<int64_t>(
-            int32_t(ctx->global_words[trax::layout::kHeaderFramebuffer]), 0,
-            ctx->global_word_count);
+        thread.read_only_words =
+            std::clamp<int64_t>(int32_t(ctx->global_words[trax::layout::kHeaderFramebuffer]), 0,
+                                ctx->global_word_count);
     thread.global_registers = global_registers;
     thread.num_threads = static_cast<int>(ctx->num_threads);
     thread.num_tms = static_cast<int>(ctx->num_tms);

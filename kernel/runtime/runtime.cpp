@@ -14,7 +14,8 @@ void* memcpy(void* __restrict dst, const void* __restrict src, size_t n) {
         for (; n >= 4; n -= 4, d += 4, s += 4)
             *reinterpret_cast<uint32_t*>(d) = *reinterpret_cast<const uint32_t*>(s);
     }
-    while (n--) *d++ = *s++;
+    while (n--)
+        *d++ = *s++;
     return dst;
 }
 
@@ -23,9 +24,11 @@ void* memmove(void* dst, const void* src, size_t n) {
     const auto* s = static_cast<const unsigned char*>(src);
     if (d == s || n == 0) return dst;
     if (d < s) {
-        while (n--) *d++ = *s++;
+        while (n--)
+            *d++ = *s++;
     } else {
-        while (n--) d[n] = s[n];
+        while (n--)
+            d[n] = s[n];
     }
     return dst;
 }
@@ -35,9 +38,11 @@ void* memset(void* dst, int value, size_t n) {
     const auto byte = static_cast<unsigned char>(value);
     if ((reinterpret_cast<uintptr_t>(d) & 3u) == 0) {
         const uint32_t word = byte * 0x0101'0101u;
-        for (; n >= 4; n -= 4, d += 4) *reinterpret_cast<uint32_t*>(d) = word;
+        for (; n >= 4; n -= 4, d += 4)
+            *reinterpret_cast<uint32_t*>(d) = word;
     }
-    while (n--) *d++ = byte;
+    while (n--)
+        *d++ = byte;
     return dst;
 }
 

@@ -21,18 +21,21 @@ Command add_exec_command(CLI::App& app) {
     command->add_option("program", options->program, "RV32IMF ELF executable")
         ->required()
         ->check(CLI::ExistingFile);
-    command->add_option("--max-instructions", options->machine.max_instructions,
-                        "Instructions a thread may run before it is stopped as a runaway")
+    command
+        ->add_option("--max-instructions", options->machine.max_instructions,
+                     "Instructions a thread may run before it is stopped as a runaway")
         ->capture_default_str()
         ->check(kPositiveCount);
-    command->add_option("--local-store", options->machine.local_store_bytes,
-                        "Bytes of per-thread local store (stack); multiple of 16 in [256, 1048576]")
+    command
+        ->add_option("--local-store", options->machine.local_store_bytes,
+                     "Bytes of per-thread local store (stack); multiple of 16 in [256, 1048576]")
         ->capture_default_str();
     return {command, [options] {
-        tpsim::core::Machine machine(tpsim::core::load_elf(options->program), options->machine);
-        machine.run();
-        return machine.thread(0).exit_code;
-    }};
+                tpsim::core::Machine machine(tpsim::core::load_elf(options->program),
+                                             options->machine);
+                machine.run();
+                return machine.thread(0).exit_code;
+            }};
 }
 
 }  // namespace tpsim::cli

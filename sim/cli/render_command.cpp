@@ -64,7 +64,8 @@ public:
             share > start_share_
                 ? fmt::format("~{:.0f} s left", elapsed * (1 - share) / (share - start_share_))
                 : "estimating time left";
-        fmt::print(stderr, "\r{:5.1f}% of pixels, {} cycles, {}\033[K", 100 * share, p.cycles, left);
+        fmt::print(stderr, "\r{:5.1f}% of pixels, {} cycles, {}\033[K", 100 * share, p.cycles,
+                   left);
         shown_ = true;
     }
 
@@ -107,13 +108,14 @@ int run_render(const RenderCommandOptions& o) {
     render::RenderOptions options;
     options.scene = o.scene;
     options.kernel = resolve_kernel(o.kernel);
-    options.engine = o.native             ? render::Engine::native
+    options.engine = o.native              ? render::Engine::native
                      : o.timing == "cycle" ? render::Engine::timing
                                            : render::Engine::functional;
     options.max_instructions = o.max_instructions;
     options.timeline_interval = o.timeline_cycles;
     if (!o.config.empty()) options.chip = timing::load_config(o.config);
-    for (const std::string& assignment : o.overrides) timing::apply_override(options.chip, assignment);
+    for (const std::string& assignment : o.overrides)
+        timing::apply_override(options.chip, assignment);
     options.bvh.builder = o.bvh == "binned" ? scene::BvhBuilder::binned : scene::BvhBuilder::sweep;
     options.bvh.max_leaf_size = o.max_leaf;
 
@@ -130,7 +132,7 @@ int run_render(const RenderCommandOptions& o) {
     if (!o.heatmap.empty()) render::check_heatmap_path(o.heatmap);
     options.profile = o.profile || !o.annotate.empty();
     if (options.engine != render::Engine::timing) {
-        const char* needs = options.profile ? "--profile and --annotate need"
+        const char* needs = options.profile      ? "--profile and --annotate need"
                             : !o.heatmap.empty() ? "--heatmap needs"
                                                  : nullptr;
         if (needs)
@@ -161,8 +163,8 @@ int run_render(const RenderCommandOptions& o) {
     }
     if (!o.heatmap.empty()) {
         const render::HeatmapFiles files =
-            render::write_heatmap(o.heatmap, result.timing->chip->work_items(),
-                                  result.scene.width, result.scene.height, heat_metric);
+            render::write_heatmap(o.heatmap, result.timing->chip->work_items(), result.scene.width,
+                                  result.scene.height, heat_metric);
         fmt::print("heatmap  {} ({} per pixel; raw values in {})\n", files.png.string(),
                    render::metric_name(heat_metric), files.exr.string());
         if (!files.legend_problem.empty())
@@ -204,18 +206,25 @@ Command add_render_command(CLI::App& app) {
         "render", "Render a scene (.toml scene file or a mesh: .obj .ply .off ...) with a kernel "
                   "on the simulated chip; write the image and print statistics");
     auto o = std::make_shared<RenderCommandOptions>();
-    command->add_option("scene", o->scene, "Scene file or mesh")->required()->check(CLI::ExistingFile);
-    command->add_option("-o,--output", o->output,
-                        "Image to write (.png 8-bit sRGB; .exr/.tif linear float) [default: SCENE.png]");
+    command->add_option("scene", o->scene, "Scene file or mesh")
+        ->required()
+        ->check(CLI::ExistingFile);
+    command->add_option(
+        "-o,--output", o->output,
+        "Image to write (.png 8-bit sRGB; .exr/.tif linear float) [default: SCENE.png]");
     command->add_option("-k,--kernel", o->kernel, "Built kernel name, or a path to a kernel ELF")
         ->capture_default_str();
-    command->add_option("-c,--config", o->config, "Chip configuration TOML (e.g. configs/tiny.toml) [default: built-in, the same as "
-                        "configs/trax.toml]")
+    command
+        ->add_option(
+            "-c,--config", o->config,
+            "Chip configuration TOML (e.g. configs/tiny.toml) [default: built-in, the same as "
+            "configs/trax.toml]")
         ->check(CLI::ExistingFile);
     command->add_option("-s,--set", o->overrides,
                         "Override one chip configuration field, e.g. --set chip.num_tms=8");
-    command->add_option("--bvh", o->bvh,
-                        "BVH builder, used when the kernel traverses a BVH (TRAX_USES_BVH)")
+    command
+        ->add_option("--bvh", o->bvh,
+                     "BVH builder, used when the kernel traverses a BVH (TRAX_USES_BVH)")
         ->check(CLI::IsMember({"sweep", "binned"}))
         ->capture_default_str();
     command->add_option("--max-leaf", o->max_leaf, "Most triangles in one BVH leaf")
@@ -223,9 +232,10 @@ Command add_render_command(CLI::App& app) {
         ->capture_default_str();
     command->add_flag("--native", o->native,
                       "Run the kernel's native twin on the host instead of the simulator");
-    command->add_option("--timing", o->timing,
-                        "cycle: the cycle-level chip model (cycles, stalls, caches, DRAM); "
-                        "none: the functional simulator only (fast, same image)")
+    command
+        ->add_option("--timing", o->timing,
+                     "cycle: the cycle-level chip model (cycles, stalls, caches, DRAM); "
+                     "none: the functional simulator only (fast, same image)")
         ->check(CLI::IsMember({"cycle", "none"}))
         ->capture_default_str();
     command->add_option("--stats-json", o->stats_json,
@@ -244,18 +254,21 @@ Command add_render_command(CLI::App& app) {
     command->add_option("--heatmap", o->heatmap,
                         "Write a false-colour PNG of the cost per pixel here (with a legend), and "
                         "the raw values beside it as EXR");
-    command->add_option("--heatmap-metric", o->heatmap_metric,
-                        "What the heat map shows: cycles, instructions or dram_bytes per pixel")
+    command
+        ->add_option("--heatmap-metric", o->heatmap_metric,
+                     "What the heat map shows: cycles, instructions or dram_bytes per pixel")
         ->capture_default_str();
     command->add_option("--html", o->html,
                         "Write a self-contained HTML report of the run here (as tpsim report "
                         "makes from a statistics file)");
-    command->add_option("--timeline-cycles", o->timeline_cycles,
-                        "Cycles per row of the statistics file's timeline; 0: adapt to the run "
-                        "(200-400 rows)")
+    command
+        ->add_option("--timeline-cycles", o->timeline_cycles,
+                     "Cycles per row of the statistics file's timeline; 0: adapt to the run "
+                     "(200-400 rows)")
         ->capture_default_str();
-    command->add_option("--max-instructions", o->max_instructions,
-                        "Instructions a thread may run before it is stopped as a runaway")
+    command
+        ->add_option("--max-instructions", o->max_instructions,
+                     "Instructions a thread may run before it is stopped as a runaway")
         ->check(kPositiveCount)
         ->capture_default_str();
     return {command, [o] { return run_render(*o); }};

@@ -11,8 +11,8 @@
 #include <memory>
 
 #include <cxxabi.h>
-#include <elf.h>
 #include <dwarf.h>
+#include <elf.h>
 #include <elfutils/libdw.h>
 #include <fmt/format.h>
 #include <gelf.h>
@@ -304,7 +304,7 @@ void read_lines(Elf* elf, Program& program) {
                      [](const auto& a, const auto& b) { return a.address < b.address; });
 }
 
-} // namespace
+}  // namespace
 
 const Symbol* Program::function_at(uint32_t pc) const {
     auto it = std::upper_bound(functions.begin(), functions.end(), pc,
@@ -353,7 +353,7 @@ inlined_around(const std::vector<Program::InlinedCall>& calls, uint32_t pc) {
     return around;
 }
 
-} // namespace
+}  // namespace
 
 std::vector<SourceLocation> Program::inlined_call_sites(uint32_t pc) const {
     std::vector<SourceLocation> sites;
@@ -407,8 +407,8 @@ Program load_elf(std::span<const uint8_t> image, const std::string& name) {
 Program load_elf(const std::string& path) {
     // Reading a directory through an ifstream throws an unhelpful std::ios_base::failure.
     if (std::error_code ec; std::filesystem::is_directory(path, ec))
-        throw Error(fmt::format("cannot load '{}': it is a directory; give the path of an ELF file",
-                                path));
+        throw Error(
+            fmt::format("cannot load '{}': it is a directory; give the path of an ELF file", path));
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(fmt::format("cannot open '{}': no such file or not readable", path));
     std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)),
@@ -417,4 +417,4 @@ Program load_elf(const std::string& path) {
     return load_elf(bytes, path);
 }
 
-} // namespace tpsim::core
+}  // namespace tpsim::core

@@ -23,11 +23,11 @@ struct Segment {
 struct Symbol {
     std::string name;
     uint32_t address = 0;
-    uint32_t size = 0; ///< 0 when the symbol carries no size (plain assembly labels)
+    uint32_t size = 0;  ///< 0 when the symbol carries no size (plain assembly labels)
 };
 
 struct SourceLocation {
-    std::string file; ///< file name as recorded by the compiler (no directory), for messages
+    std::string file;  ///< file name as recorded by the compiler (no directory), for messages
     uint32_t line = 0;
     /// The full path DWARF gives (DW_AT_comp_dir, the line table's directory and the file
     /// name), for reading the source; it need not exist on this machine.
@@ -36,11 +36,11 @@ struct SourceLocation {
 
 /// Everything the simulator needs from the ELF; no libelf handles are kept.
 class Program {
-  public:
-    std::string name; ///< path or label, for messages
+public:
+    std::string name;  ///< path or label, for messages
     uint32_t entry = 0;
-    std::vector<Segment> segments; ///< sorted by vaddr, non-overlapping
-    std::vector<Symbol> functions; ///< sorted by address
+    std::vector<Segment> segments;  ///< sorted by vaddr, non-overlapping
+    std::vector<Symbol> functions;  ///< sorted by address
 
     /// The function containing pc, or the nearest preceding unsized label; nullptr if none.
     const Symbol* function_at(uint32_t pc) const;
@@ -62,12 +62,12 @@ class Program {
     struct LineRow {
         uint32_t address;
         uint32_t line;
-        uint32_t file; ///< index into line_files
+        uint32_t file;  ///< index into line_files
         bool end_sequence;
     };
     std::vector<LineRow> line_rows;
     struct SourceFile {
-        std::string file, path; ///< as in SourceLocation
+        std::string file, path;  ///< as in SourceLocation
     };
     std::vector<SourceFile> line_files;
     /// Loader-internal: one address range of an inlined call (DW_TAG_inlined_subroutine).
@@ -91,4 +91,4 @@ Program load_elf(const std::string& path);
 /// Same, from bytes already in memory; `name` is used in messages.
 Program load_elf(std::span<const uint8_t> image, const std::string& name);
 
-} // namespace tpsim::core
+}  // namespace tpsim::core

@@ -8,8 +8,8 @@ namespace tpsim {
 /// Thrown for every user-facing error (bad input files, bad options, guest faults).
 /// what() is one line without a trailing newline; the command prefixes it with "tpsim: ".
 class Error : public std::runtime_error {
-  public:
+public:
     explicit Error(const std::string& message) : std::runtime_error(message) {}
 };
 
-} // namespace tpsim
+}  // namespace tpsim

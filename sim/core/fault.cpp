@@ -30,4 +30,4 @@ std::string_view to_string(FaultKind kind) {
     return "fault";
 }
 
-} // namespace tpsim::core
+}  // namespace tpsim::core

@@ -9,17 +9,17 @@
 namespace tpsim::core {
 
 enum class FaultKind : uint8_t {
-    NullAccess,         ///< load/store below kCodeBase
-    Unmapped,           ///< load/store to an address no region maps
-    Misaligned,         ///< load/store/fetch not aligned to its size (TRaX has no unaligned access)
-    WriteToReadOnly,    ///< store into text/rodata
-    StackOverflow,      ///< access just below the thread's local store
-    FetchOutsideCode,   ///< pc left the executable segments
-    IllegalInstruction, ///< word that decodes to no instruction, or an unknown CSR
-    Breakpoint,         ///< ebreak
-    UnsupportedEcall,   ///< ecall other than exit, with no trap handler installed
-    BadGlobalRegister,  ///< atomic on a global register that does not exist
-    InstructionLimit,   ///< thread ran past --max-instructions
+    NullAccess,        ///< load/store below kCodeBase
+    Unmapped,          ///< load/store to an address no region maps
+    Misaligned,        ///< load/store/fetch not aligned to its size (TRaX has no unaligned access)
+    WriteToReadOnly,   ///< store into text/rodata
+    StackOverflow,     ///< access just below the thread's local store
+    FetchOutsideCode,  ///< pc left the executable segments
+    IllegalInstruction,  ///< word that decodes to no instruction, or an unknown CSR
+    Breakpoint,          ///< ebreak
+    UnsupportedEcall,    ///< ecall other than exit, with no trap handler installed
+    BadGlobalRegister,   ///< atomic on a global register that does not exist
+    InstructionLimit,    ///< thread ran past --max-instructions
 };
 
 std::string_view to_string(FaultKind kind);
@@ -28,23 +28,23 @@ std::string_view to_string(FaultKind kind);
 /// rethrows a Fault that names the thread, pc, function, source line and instruction.
 struct GuestFault {
     FaultKind kind;
-    std::string detail; ///< what the instruction did, e.g. "writes 0x7ffff7fc, below ..."
-    std::string hint;   ///< how to fix it
+    std::string detail;  ///< what the instruction did, e.g. "writes 0x7ffff7fc, below ..."
+    std::string hint;    ///< how to fix it
 };
 
 /// The one-line, user-facing fault.
 class Fault : public Error {
-  public:
+public:
     Fault(FaultKind kind, uint32_t thread, uint32_t pc, const std::string& message)
         : Error(message), kind_(kind), thread_(thread), pc_(pc) {}
     FaultKind kind() const { return kind_; }
     uint32_t thread() const { return thread_; }
     uint32_t pc() const { return pc_; }
 
-  private:
+private:
     FaultKind kind_;
     uint32_t thread_;
     uint32_t pc_;
 };
 
-} // namespace tpsim::core
+}  // namespace tpsim::core

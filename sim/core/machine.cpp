@@ -20,9 +20,8 @@ void MachineConfig::validate() const {
 
 Machine::Machine(Program program, const MachineConfig& config)
     : program_(std::move(program)), config_(config),
-      memory_(program_,
-              MemoryConfig{config.global_bytes, config.read_only_global_bytes,
-                           config.local_store_bytes, config.threads}) {
+      memory_(program_, MemoryConfig{config.global_bytes, config.read_only_global_bytes,
+                                     config.local_store_bytes, config.threads}) {
     config_.validate();
     // Decode the file-backed span of the executable segments once. Words in gaps between them
     // decode as illegal and are reported as fetches outside the code; a zero-filled tail (memsz
@@ -39,18 +38,27 @@ Machine::Machine(Program program, const MachineConfig& config)
     privacy_.reserve(decoded_.size());
     for (const isa::Decoded& d : decoded_) {
         switch (isa::info(d.op).fu) {
-        case isa::FuClass::Load: privacy_.push_back(Privacy::Load); break;
-        case isa::FuClass::Store: privacy_.push_back(Privacy::Store); break;
+        case isa::FuClass::Load:
+            privacy_.push_back(Privacy::Load);
+            break;
+        case isa::FuClass::Store:
+            privacy_.push_back(Privacy::Store);
+            break;
         case isa::FuClass::Atomic:
-        case isa::FuClass::System: privacy_.push_back(Privacy::Never); break;
-        default: privacy_.push_back(Privacy::Always); break;
+        case isa::FuClass::System:
+            privacy_.push_back(Privacy::Never);
+            break;
+        default:
+            privacy_.push_back(Privacy::Always);
+            break;
         }
     }
 
     threads_.resize(config_.threads);
     for (Thread& t : threads_) {
         t.hart.pc = program_.entry;
-        t.hart.reg[detail::kSp] = trax::map::kLocalTop; // the runtime may set it again; asm tests need not
+        t.hart.reg[detail::kSp] =
+            trax::map::kLocalTop;  // the runtime may set it again; asm tests need not
     }
 }
 
@@ -78,7 +86,7 @@ void Machine::fault(uint32_t id, uint32_t pc, const GuestFault& what) {
 
 void Machine::fetch_fault(uint32_t id, uint32_t pc) {
     const Segment* segment = program_.segment_at(pc);
-    if (pc % 4 == 0 && segment && segment->executable) // the zero-filled tail of a code segment
+    if (pc % 4 == 0 && segment && segment->executable)  // the zero-filled tail of a code segment
         fault(id, pc,
               {FaultKind::IllegalInstruction,
                "word 0x00000000 (zero fill past the end of the code) is not an RV32IMF "
@@ -222,8 +230,8 @@ void Machine::illegal(uint32_t id, isa::Hart& h, const isa::Decoded& d) {
 
 void Machine::refuse_step(uint32_t id) {
     if (id >= thread_count())
-        throw Error(fmt::format("step(): there is no thread {} (the machine has {})", id,
-                                thread_count()));
+        throw Error(
+            fmt::format("step(): there is no thread {} (the machine has {})", id, thread_count()));
     if (threads_[id].state != ThreadState::Running)
         throw Error(fmt::format("step(): thread {} is not running; the timing model must stop "
                                 "issuing from exited threads",
@@ -238,4 +246,4 @@ StepRecord Machine::step(uint32_t id) {
     return record;
 }
 
-} // namespace tpsim::core
+}  // namespace tpsim::core

@@ -40,8 +40,8 @@ constexpr uint32_t kParkedPc = 0;
 struct Thread {
     isa::Hart hart;
     ThreadState state = ThreadState::Running;
-    int32_t exit_code = 0; ///< a0 of the exit ecall
-    uint32_t exit_pc = 0;  ///< address of the exit ecall (hart.pc is parked at kParkedPc)
+    int32_t exit_code = 0;  ///< a0 of the exit ecall
+    uint32_t exit_pc = 0;   ///< address of the exit ecall (hart.pc is parked at kParkedPc)
     /// Instructions executed, including the exit ecall and trapping ones (which instret does
     /// not count); checked against max_instructions.
     uint64_t executed = 0;
@@ -49,27 +49,27 @@ struct Thread {
 
 /// What one instruction did, for the timing model (step()).
 struct StepRecord {
-    uint32_t pc = 0;                    ///< address of the instruction
-    uint32_t atomic_result = 0;         ///< the value an atomic increment returned
-    const isa::Decoded* insn = nullptr; ///< its pre-decoded form (registers, FU class)
-    uint32_t mem_address = 0;           ///< effective address when mem_bytes != 0
-    uint8_t mem_bytes = 0;              ///< access size; 0 = no memory access
+    uint32_t pc = 0;                     ///< address of the instruction
+    uint32_t atomic_result = 0;          ///< the value an atomic increment returned
+    const isa::Decoded* insn = nullptr;  ///< its pre-decoded form (registers, FU class)
+    uint32_t mem_address = 0;            ///< effective address when mem_bytes != 0
+    uint8_t mem_bytes = 0;               ///< access size; 0 = no memory access
     bool mem_store = false;
-    bool taken = false;  ///< control left the fall-through path (branch, jump, trap)
-    bool exited = false; ///< the instruction ended the thread
+    bool taken = false;   ///< control left the fall-through path (branch, jump, trap)
+    bool exited = false;  ///< the instruction ended the thread
 };
 static_assert(sizeof(StepRecord) == 24, "the timing model buffers 128 per thread");
 
 struct Counters {
     uint64_t instructions = 0;
-    std::array<uint64_t, size_t(isa::Op::Count)> per_op{}; ///< indexed by isa::Op
+    std::array<uint64_t, size_t(isa::Op::Count)> per_op{};  ///< indexed by isa::Op
 };
 
 /// Number of global registers for tp.atominc (all start at 0).
 constexpr uint32_t kGlobalRegisters = 256;
 
 class Machine {
-  public:
+public:
     Machine(Program program, const MachineConfig& config);
 
     /// Runs every thread to its exit, round-robin by thread id in fixed quanta, so results never
@@ -105,7 +105,7 @@ class Machine {
     const Counters& counters() const { return counters_; }
     uint32_t global_register(uint32_t index) const { return global_registers_.at(index); }
 
-  private:
+private:
     template <bool kRecord> friend class ThreadEnv;
 
     void run_quantum(uint32_t id, uint64_t budget);
@@ -130,7 +130,7 @@ class Machine {
     Memory memory_;
     uint32_t text_base_ = 0;
     uint32_t text_bytes_ = 0;
-    std::vector<isa::Decoded> decoded_; ///< the executable range, one entry per word
+    std::vector<isa::Decoded> decoded_;  ///< the executable range, one entry per word
     /// Per word of decoded_: whether the instruction is private (is_private): always,
     /// never, or depending on the address it loads from or stores to.
     enum class Privacy : uint8_t { Always, Never, Load, Store };
@@ -141,4 +141,4 @@ class Machine {
     const uint64_t* cycle_counter_ = nullptr;
 };
 
-} // namespace tpsim::core
+}  // namespace tpsim::core

@@ -28,7 +28,7 @@ std::string range(uint32_t base, uint64_t end) {
     return fmt::format("[{:#010x}, {:#010x})", base, end);
 }
 
-} // namespace
+}  // namespace
 
 void MemoryConfig::validate() const {
     if (local_store_bytes < kMinLocalStore || local_store_bytes > kMaxLocalStore ||
@@ -109,11 +109,12 @@ void Memory::fault(uint32_t addr, uint32_t bytes, bool store) const {
                                      range(region->base, uint64_t(region->base) + region->size)),
                          "check array bounds and the size of the scene image"};
     if (region == &global_ && store && in_read_only_global(addr))
-        throw GuestFault{FaultKind::WriteToReadOnly,
-                         fmt::format("{}, inside the read-only scene data {}", what,
-                                     range(global_.base, uint64_t(global_.base) + read_only_global_)),
-                         "the scene (header to BVH) is read-only while a kernel runs; write "
-                         "results to the framebuffer, thread_stats or ray_results sections"};
+        throw GuestFault{
+            FaultKind::WriteToReadOnly,
+            fmt::format("{}, inside the read-only scene data {}", what,
+                        range(global_.base, uint64_t(global_.base) + read_only_global_)),
+            "the scene (header to BVH) is read-only while a kernel runs; write "
+            "results to the framebuffer, thread_stats or ray_results sections"};
     if (region && store && !region->writable)
         throw GuestFault{FaultKind::WriteToReadOnly,
                          fmt::format("{}, inside the read-only program segment {}", what,
@@ -134,4 +135,4 @@ void Memory::fault(uint32_t addr, uint32_t bytes, bool store) const {
                      "check pointer arithmetic and array bounds (see docs/memory-map.md)"};
 }
 
-} // namespace tpsim::core
+}  // namespace tpsim::core

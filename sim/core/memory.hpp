@@ -32,7 +32,7 @@ struct MemoryConfig {
 /// is an alignment test, one or two range compares and a memcpy. Anything else is classified
 /// by a cold path that throws GuestFault.
 class Memory {
-  public:
+public:
     Memory(const Program& program, const MemoryConfig& config);
 
     /// Global memory, for the host to write the scene image and read the framebuffer.
@@ -44,7 +44,9 @@ class Memory {
     }
     uint32_t local_base() const { return local_.base; }
     /// True if `addr` is in the read-only part of global memory.
-    bool in_read_only_global(uint32_t addr) const { return addr - global_.base < read_only_global_; }
+    bool in_read_only_global(uint32_t addr) const {
+        return addr - global_.base < read_only_global_;
+    }
     uint32_t local_store_bytes() const { return local_.size; }
 
     template <class T> T load(uint32_t addr, uint8_t* local) const {
@@ -60,7 +62,7 @@ class Memory {
     /// Reads an instruction word of the program (for disassembly in messages); 0 if unmapped.
     uint32_t code_word(uint32_t addr) const;
 
-  private:
+private:
     struct Region {
         uint32_t base = 0;
         uint32_t size = 0;
@@ -93,12 +95,12 @@ class Memory {
     [[noreturn]] void fault(uint32_t addr, uint32_t bytes, bool store) const;
 
     std::vector<Buffer> program_buffers_;
-    std::vector<Region> program_regions_; ///< ELF segments, by address
+    std::vector<Region> program_regions_;  ///< ELF segments, by address
     Buffer global_buffer_;
     Region global_;
-    uint32_t read_only_global_ = 0; ///< bytes at the start of global_
-    Buffer local_stores_; ///< threads x local_.size bytes, zeroed lazily by calloc
-    Region local_;        ///< the window; data is per thread
+    uint32_t read_only_global_ = 0;  ///< bytes at the start of global_
+    Buffer local_stores_;            ///< threads x local_.size bytes, zeroed lazily by calloc
+    Region local_;                   ///< the window; data is per thread
 };
 
-} // namespace tpsim::core
+}  // namespace tpsim::core

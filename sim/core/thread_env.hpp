@@ -15,19 +15,19 @@ namespace tpsim::core {
 
 namespace detail {
 
-constexpr uint32_t kExitSyscall = 93; // a7 value of exit(a0), as in Linux/newlib
-constexpr uint32_t kCauseIllegal = 2; // mcause values of the privileged spec
+constexpr uint32_t kExitSyscall = 93;  // a7 value of exit(a0), as in Linux/newlib
+constexpr uint32_t kCauseIllegal = 2;  // mcause values of the privileged spec
 constexpr uint32_t kCauseEcallM = 11;
 constexpr unsigned kA0 = 10, kA7 = 17, kSp = 2;
 
 struct NoRecorder {};
 
-} // namespace detail
+}  // namespace detail
 
 /// The isa::execute environment of one thread. kRecord adds the bookkeeping step() reports,
 /// written straight into its record; the fast path instantiates it away.
 template <bool kRecord> class ThreadEnv {
-  public:
+public:
     using Record = std::conditional_t<kRecord, StepRecord*, detail::NoRecorder>;
 
     ThreadEnv(Machine& machine, uint32_t id, Record record = {})
@@ -81,7 +81,7 @@ template <bool kRecord> class ThreadEnv {
     /// Where the next instruction's bookkeeping goes (recording environments only).
     void record_into(StepRecord* record) { record_ = record; }
 
-  private:
+private:
     [[noreturn, gnu::cold, gnu::noinline]] static void bad_global_register(uint32_t index) {
         throw GuestFault{FaultKind::BadGlobalRegister,
                          fmt::format("uses global register {}, but there are only {} (0..{})",
@@ -181,4 +181,4 @@ inline bool Machine::is_private(const isa::Hart& h, uint32_t index, uint32_t tex
            (privacy == Privacy::Load && memory_.in_read_only_global(addr));
 }
 
-} // namespace tpsim::core
+}  // namespace tpsim::core

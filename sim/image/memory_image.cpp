@@ -93,7 +93,8 @@ MemoryImage build_memory_image(const scene::Scene& scene, const scene::Bvh* bvh,
 
     const auto checked_count = [](size_t n, const char* what) {
         if (n > size_t(std::numeric_limits<int32_t>::max() / 16))
-            throw Error(fmt::format("scene has too many {} ({}) for the 32-bit memory image", what, n));
+            throw Error(
+                fmt::format("scene has too many {} ({}) for the 32-bit memory image", what, n));
         return int32_t(n);
     };
     std::vector<layout::BvhNode> nodes;
@@ -106,14 +107,13 @@ MemoryImage build_memory_image(const scene::Scene& scene, const scene::Bvh* bvh,
     h.rays.count = checked_count(rays.size(), "rays");
     const uint64_t pixels = uint64_t(scene.width) * scene.height;
     if (pixels > uint64_t(std::numeric_limits<int32_t>::max() / 16))
-        throw Error(fmt::format("image {}x{} is too large for the 32-bit memory image",
-                                scene.width, scene.height));
-    const uint64_t estimate = uint64_t(h.triangles.count) * layout::kTriangleWords +
-                              uint64_t(h.bvh_nodes.count) * layout::kBvhNodeWords +
-                              pixels * layout::kPixelWords +
-                              uint64_t(threads) * layout::kThreadStatsWords +
-                              uint64_t(rays.size()) * (layout::kRayWords + layout::kRayResultWords) +
-                              4096;
+        throw Error(fmt::format("image {}x{} is too large for the 32-bit memory image", scene.width,
+                                scene.height));
+    const uint64_t estimate =
+        uint64_t(h.triangles.count) * layout::kTriangleWords +
+        uint64_t(h.bvh_nodes.count) * layout::kBvhNodeWords + pixels * layout::kPixelWords +
+        uint64_t(threads) * layout::kThreadStatsWords +
+        uint64_t(rays.size()) * (layout::kRayWords + layout::kRayResultWords) + 4096;
     // Global memory spans kGlobalBase..kLocalTop - kStackGuard in the guest address space.
     constexpr uint64_t kMaxWords =
         (trax::map::kLocalTop - trax::map::kStackGuard - trax::map::kGlobalBase) / 4;

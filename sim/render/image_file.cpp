@@ -25,8 +25,8 @@ bool is_float_format(std::string extension) {
 uint8_t encode_srgb(float linear) {
     if (!(linear > 0.f)) return 0;  // also maps NaN to black
     if (linear >= 1.f) return 255;
-    const float v = linear <= 0.0031308f ? 12.92f * linear
-                                         : 1.055f * std::pow(linear, 1.f / 2.4f) - 0.055f;
+    const float v =
+        linear <= 0.0031308f ? 12.92f * linear : 1.055f * std::pow(linear, 1.f / 2.4f) - 0.055f;
     return uint8_t(std::lround(v * 255.f));
 }
 
@@ -35,12 +35,11 @@ uint8_t encode_srgb(float linear) {
 void check_image_path(const std::filesystem::path& path) {
     if (!OIIO::ImageOutput::create(path.string())) {
         OIIO::geterror();  // consumed here: the message below says it better
-        throw Error(fmt::format("cannot write image '{}': {}; use .png, .exr, .tif, .ppm ...",
-                                path.string(),
-                                path.has_extension()
-                                    ? fmt::format("no image format has the extension '{}'",
-                                                  path.extension().string())
-                                    : std::string("the name has no image extension")));
+        throw Error(fmt::format(
+            "cannot write image '{}': {}; use .png, .exr, .tif, .ppm ...", path.string(),
+            path.has_extension()
+                ? fmt::format("no image format has the extension '{}'", path.extension().string())
+                : std::string("the name has no image extension")));
     }
     const std::filesystem::path directory =
         path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
@@ -56,8 +55,8 @@ void write_image(const std::filesystem::path& path, std::span<const float> rgb, 
         throw Error(fmt::format("cannot write image '{}': {} (use .png, .exr, .tif, .ppm ...)",
                                 path.string(), OIIO::geterror()));
     const bool linear = is_float_format(path.extension().string());
-    OIIO::ImageSpec spec(int(width), int(height), 3, linear ? OIIO::TypeDesc::FLOAT
-                                                            : OIIO::TypeDesc::UINT8);
+    OIIO::ImageSpec spec(int(width), int(height), 3,
+                         linear ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
     spec.attribute("oiio:ColorSpace", linear ? "linear" : "sRGB");
     // OpenImageIO stamps TIFF and EXR files with the current time unless DateTime is given;
     // empty leaves it out, so the same render gives the same bytes.
@@ -77,7 +76,8 @@ void write_image(const std::filesystem::path& path, std::span<const float> rgb, 
 std::vector<float> read_image(const std::filesystem::path& path, uint32_t& width,
                               uint32_t& height) {
     auto in = OIIO::ImageInput::open(path.string());
-    if (!in) throw Error(fmt::format("cannot read image '{}': {}", path.string(), OIIO::geterror()));
+    if (!in)
+        throw Error(fmt::format("cannot read image '{}': {}", path.string(), OIIO::geterror()));
     const OIIO::ImageSpec& spec = in->spec();
     width = uint32_t(spec.width);
     height = uint32_t(spec.height);

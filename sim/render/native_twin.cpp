@@ -46,18 +46,23 @@ private:
 
 std::string describe_signal(int signal) {
     switch (signal) {
-        case SIGSEGV:
-            return "SIGSEGV: an invalid memory access (null or wild pointer, or a stack overflow "
-                   "from deep recursion)";
-        case SIGBUS: return "SIGBUS: a misaligned or invalid memory access";
-        case SIGFPE: return "SIGFPE: an integer division by zero";
-        case SIGILL: return "SIGILL: an illegal instruction";
-        case SIGABRT: return "SIGABRT: the kernel aborted";
-        case SIGALRM:
-            return fmt::format("no result after {} s (an endless loop? the simulator stops one "
-                               "with --max-instructions and names where it is)",
-                               kTimeLimitSeconds);
-        default: return fmt::format("signal {} ({})", signal, strsignal(signal));
+    case SIGSEGV:
+        return "SIGSEGV: an invalid memory access (null or wild pointer, or a stack overflow "
+               "from deep recursion)";
+    case SIGBUS:
+        return "SIGBUS: a misaligned or invalid memory access";
+    case SIGFPE:
+        return "SIGFPE: an integer division by zero";
+    case SIGILL:
+        return "SIGILL: an illegal instruction";
+    case SIGABRT:
+        return "SIGABRT: the kernel aborted";
+    case SIGALRM:
+        return fmt::format("no result after {} s (an endless loop? the simulator stops one "
+                           "with --max-instructions and names where it is)",
+                           kTimeLimitSeconds);
+    default:
+        return fmt::format("signal {} ({})", signal, strsignal(signal));
     }
 }
 
@@ -76,7 +81,8 @@ void run_native_twin(const std::filesystem::path& library, std::vector<uint32_t>
         throw Error(fmt::format("cannot load native twin '{}': {} (build it with the kernel's "
                                 "NAME_native target)",
                                 library.string(), dlerror()));
-    const auto run = reinterpret_cast<TpsimNativeRunFn>(dlsym(handle.get(), TPSIM_NATIVE_RUN_SYMBOL));
+    const auto run =
+        reinterpret_cast<TpsimNativeRunFn>(dlsym(handle.get(), TPSIM_NATIVE_RUN_SYMBOL));
     if (run == nullptr)
         throw Error(fmt::format("'{}' is not a tpsim native twin (no {} symbol)", library.string(),
                                 TPSIM_NATIVE_RUN_SYMBOL));
@@ -89,12 +95,12 @@ void run_native_twin(const std::filesystem::path& library, std::vector<uint32_t>
     char* const error = static_cast<char*>(shared.data());
     uint32_t* const words = reinterpret_cast<uint32_t*>(error + kErrorBytes);
     std::memcpy(words, global_words.data(), image_bytes);
-    const TraxNativeContext context{words,       uint32_t(global_words.size()), num_threads,
-                                    num_tms,     tm_size,                       error,
-                                    kErrorBytes};
+    const TraxNativeContext context{
+        words, uint32_t(global_words.size()), num_threads, num_tms, tm_size, error, kErrorBytes};
     const pid_t child = fork();
-    if (child < 0) throw Error(fmt::format("cannot start the native twin: fork failed: {}",
-                                           std::strerror(errno)));
+    if (child < 0)
+        throw Error(
+            fmt::format("cannot start the native twin: fork failed: {}", std::strerror(errno)));
     if (child == 0) {
         alarm(kTimeLimitSeconds);
         _exit(run(&context) == 0 ? 0 : 1);

@@ -7,11 +7,11 @@
 
 #include "native_twin.hpp"
 #include "profile.hpp"
-#include "timing_run.hpp"
-#include "sim/timing/machine_source.hpp"
 #include "sim/core/error.hpp"
 #include "sim/core/machine.hpp"
 #include "sim/scene/load_scene.hpp"
+#include "sim/timing/machine_source.hpp"
+#include "timing_run.hpp"
 
 namespace tpsim::render {
 namespace {
@@ -54,18 +54,18 @@ bool Kernel::uses_bvh() const {
 InstructionCounts run_kernel(const Kernel& kernel, Engine engine, image::MemoryImage& image,
                              const timing::ChipConfig& chip, uint64_t max_instructions) {
     switch (engine) {
-        case Engine::functional:
-            return run_functional(kernel.program, image, chip, max_instructions);
-        case Engine::native:
-            run_native_twin(native_twin_of(kernel.elf), image.words,
-                            chip.chip.num_tms * chip.chip.tps_per_tm, chip.chip.num_tms,
-                            chip.chip.tps_per_tm);
-            break;
-        case Engine::timing: {
-            TimingRunOptions watch;
-            watch.max_instructions = max_instructions;
-            return run_timing(kernel.program, image, chip, watch)->instructions;
-        }
+    case Engine::functional:
+        return run_functional(kernel.program, image, chip, max_instructions);
+    case Engine::native:
+        run_native_twin(native_twin_of(kernel.elf), image.words,
+                        chip.chip.num_tms * chip.chip.tps_per_tm, chip.chip.num_tms,
+                        chip.chip.tps_per_tm);
+        break;
+    case Engine::timing: {
+        TimingRunOptions watch;
+        watch.max_instructions = max_instructions;
+        return run_timing(kernel.program, image, chip, watch)->instructions;
+    }
     }
     return {};
 }
@@ -93,18 +93,17 @@ RenderResult render(const RenderOptions& options) {
 
     start = std::chrono::steady_clock::now();
     if (options.engine == Engine::timing) {
-        result.timing = run_timing(kernel.program, result.image, options.chip,
-                                   {options.max_instructions,
-                                    uint64_t(result.scene.width) * result.scene.height,
-                                    options.on_progress, options.timeline_interval,
-                                    options.profile});
+        result.timing = run_timing(
+            kernel.program, result.image, options.chip,
+            {options.max_instructions, uint64_t(result.scene.width) * result.scene.height,
+             options.on_progress, options.timeline_interval, options.profile});
         if (options.profile)
             result.profile = std::make_shared<const Profile>(
                 profile_of(result.timing->chip->profile(), kernel.program));
         result.instructions = result.timing->instructions;
     } else {
-        result.instructions = run_kernel(kernel, options.engine, result.image,
-                                         options.chip, options.max_instructions);
+        result.instructions = run_kernel(kernel, options.engine, result.image, options.chip,
+                                         options.max_instructions);
     }
     result.run_seconds = seconds_since(start);
     result.traversal = image::read_thread_stats(result.image.header, result.image.words.data());

@@ -61,9 +61,9 @@ struct RenderOptions {
     scene::BvhConfig bvh;
     /// Overrides the scene file's image size when non-zero (tests render small images).
     uint32_t image_width = 0, image_height = 0;
-    timing::ChipConfig chip;       ///< shape (TMs x TPs) and local-store size
+    timing::ChipConfig chip;                        ///< shape (TMs x TPs) and local-store size
     uint64_t max_instructions = uint64_t(1) << 32;  ///< per thread, for runaway kernels
-    ProgressCallback on_progress;  ///< Engine::timing calls it now and then while it runs
+    ProgressCallback on_progress;    ///< Engine::timing calls it now and then while it runs
     uint64_t timeline_interval = 0;  ///< Engine::timing: cycles per timeline row, 0 = adapt
     bool profile = false;  ///< Engine::timing: collect the source-line profile (RenderResult)
 };
@@ -79,12 +79,12 @@ struct InstructionCounts {
 };
 
 struct RenderResult {
-    scene::Scene scene;                      ///< as loaded (triangles included)
-    std::optional<scene::BvhStats> bvh;      ///< when a BVH was built
-    image::MemoryImage image;                ///< the memory image after the run
-    image::TraversalTotals traversal;        ///< the kernel's per-thread statistics, summed
-    std::vector<float> rgb;                  ///< framebuffer, linear RGB, row 0 at the top
-    InstructionCounts instructions;          ///< zero for the native engine
+    scene::Scene scene;                  ///< as loaded (triangles included)
+    std::optional<scene::BvhStats> bvh;  ///< when a BVH was built
+    image::MemoryImage image;            ///< the memory image after the run
+    image::TraversalTotals traversal;    ///< the kernel's per-thread statistics, summed
+    std::vector<float> rgb;              ///< framebuffer, linear RGB, row 0 at the top
+    InstructionCounts instructions;      ///< zero for the native engine
     uint32_t threads = 0;
     std::shared_ptr<const TimingRun> timing;  ///< Engine::timing: the chip and its counters
     std::shared_ptr<const Profile> profile;   ///< RenderOptions::profile: by function and line

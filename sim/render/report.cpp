@@ -15,9 +15,12 @@ namespace {
 
 std::string_view engine_name(Engine engine) {
     switch (engine) {
-        case Engine::functional: return "functional";
-        case Engine::native: return "native";
-        case Engine::timing: return "timing";
+    case Engine::functional:
+        return "functional";
+    case Engine::native:
+        return "native";
+    case Engine::timing:
+        return "timing";
     }
     return "";
 }
@@ -72,11 +75,11 @@ void print_traffic(const stats::Snapshot& snapshot, uint32_t line_bytes, std::os
                "store payload");
     for (const std::string& region : regions) {
         if (region == "local_store") {
-            fmt::print(out, "         {:<14} {:>12}  loads and stores, {} (private: no cache)\n",
-                       "local store",
-                       count_text(get(region, "local_store/loads") +
-                                  get(region, "local_store/stores")),
-                       bytes_text(get(region, "local_store/payload_bytes")));
+            fmt::print(
+                out, "         {:<14} {:>12}  loads and stores, {} (private: no cache)\n",
+                "local store",
+                count_text(get(region, "local_store/loads") + get(region, "local_store/stores")),
+                bytes_text(get(region, "local_store/payload_bytes")));
             continue;
         }
         if (region == "instruction_fetch") {
@@ -101,48 +104,69 @@ void print_traffic(const stats::Snapshot& snapshot, uint32_t line_bytes, std::os
 void register_stats(const RenderResult& r, stats::Registry& reg) {
     const auto number = [&reg](std::string name, auto get, std::string description,
                                std::string unit = "") {
-        reg.add_derived(std::move(name), [get] { return double(get()); }, std::move(description),
-                        std::move(unit));
+        reg.add_derived(
+            std::move(name), [get] { return double(get()); }, std::move(description),
+            std::move(unit));
     };
-    number("scene/triangles", [&r] { return r.scene.triangles.size(); }, "triangles in the scene");
-    number("scene/lights", [&r] { return r.scene.lights.size(); }, "point lights");
-    number("scene/materials", [&r] { return r.scene.materials.size(); }, "materials used");
-    number("image/pixels", [&r] { return uint64_t(r.scene.width) * r.scene.height; },
-           "pixels rendered");
-    number("image/samples_per_pixel", [&r] { return r.scene.samples_per_pixel; },
-           "camera rays per pixel");
+    number(
+        "scene/triangles", [&r] { return r.scene.triangles.size(); }, "triangles in the scene");
+    number(
+        "scene/lights", [&r] { return r.scene.lights.size(); }, "point lights");
+    number(
+        "scene/materials", [&r] { return r.scene.materials.size(); }, "materials used");
+    number(
+        "image/pixels", [&r] { return uint64_t(r.scene.width) * r.scene.height; },
+        "pixels rendered");
+    number(
+        "image/samples_per_pixel", [&r] { return r.scene.samples_per_pixel; },
+        "camera rays per pixel");
 
     for (const image::SectionSize& s : r.image.sections)
-        number("memory/" + s.name + "_bytes", [&s] { return s.bytes; },
-               fmt::format("memory image: {} ({} records)", s.name, s.records), "B");
-    number("memory/total_bytes", [&r] { return r.image.bytes(); },
-           "memory image incl. alignment padding and framebuffer", "B");
+        number(
+            "memory/" + s.name + "_bytes", [&s] { return s.bytes; },
+            fmt::format("memory image: {} ({} records)", s.name, s.records), "B");
+    number(
+        "memory/total_bytes", [&r] { return r.image.bytes(); },
+        "memory image incl. alignment padding and framebuffer", "B");
 
     if (r.bvh) {
         const scene::BvhStats& b = *r.bvh;
-        number("bvh/nodes", [&b] { return b.nodes; }, "BVH nodes (interior + leaves)");
-        number("bvh/leaves", [&b] { return b.leaves; }, "BVH leaves");
-        number("bvh/max_depth", [&b] { return b.max_depth; }, "edges from the root to the deepest leaf");
-        number("bvh/sah_cost", [&b] { return b.sah_cost; },
-               "SAH cost (traversal 1, intersection 1, relative to the root's area)");
-        number("bvh/depth_limited_nodes", [&b] { return b.depth_limited_nodes; },
-               "nodes where the traversal-stack depth limit overrode the SAH");
-        number("host/bvh_seconds", [&r] { return r.bvh_seconds; }, "BVH build time", "s");
+        number(
+            "bvh/nodes", [&b] { return b.nodes; }, "BVH nodes (interior + leaves)");
+        number(
+            "bvh/leaves", [&b] { return b.leaves; }, "BVH leaves");
+        number(
+            "bvh/max_depth", [&b] { return b.max_depth; },
+            "edges from the root to the deepest leaf");
+        number(
+            "bvh/sah_cost", [&b] { return b.sah_cost; },
+            "SAH cost (traversal 1, intersection 1, relative to the root's area)");
+        number(
+            "bvh/depth_limited_nodes", [&b] { return b.depth_limited_nodes; },
+            "nodes where the traversal-stack depth limit overrode the SAH");
+        number(
+            "host/bvh_seconds", [&r] { return r.bvh_seconds; }, "BVH build time", "s");
     }
 
     const image::TraversalTotals& t = r.traversal;
     const auto per_ray = [&t](uint64_t count) {
         return t.rays() > 0 ? double(count) / double(t.rays()) : 0.0;
     };
-    number("rays/total", [&t] { return t.rays(); }, "rays traced (primary + shadow)");
-    number("rays/primary", [&t] { return t.primary_rays; }, "closest-hit (camera) rays");
-    number("rays/shadow", [&t] { return t.shadow_rays; }, "any-hit (shadow) rays");
-    number("traversal/nodes_per_ray", [&t, per_ray] { return per_ray(t.nodes_visited); },
-           "BVH node boxes tested per ray, on average", "nodes");
-    number("traversal/triangles_per_ray", [&t, per_ray] { return per_ray(t.triangles_tested); },
-           "ray/triangle tests per ray, on average", "triangles");
-    number("traversal/max_stack_depth", [&t] { return t.max_stack_depth; },
-           "most traversal-stack entries any ray used", "entries");
+    number(
+        "rays/total", [&t] { return t.rays(); }, "rays traced (primary + shadow)");
+    number(
+        "rays/primary", [&t] { return t.primary_rays; }, "closest-hit (camera) rays");
+    number(
+        "rays/shadow", [&t] { return t.shadow_rays; }, "any-hit (shadow) rays");
+    number(
+        "traversal/nodes_per_ray", [&t, per_ray] { return per_ray(t.nodes_visited); },
+        "BVH node boxes tested per ray, on average", "nodes");
+    number(
+        "traversal/triangles_per_ray", [&t, per_ray] { return per_ray(t.triangles_tested); },
+        "ray/triangle tests per ray, on average", "triangles");
+    number(
+        "traversal/max_stack_depth", [&t] { return t.max_stack_depth; },
+        "most traversal-stack entries any ray used", "entries");
 
     if (r.instructions.total > 0) {
         reg.add_counter("instructions/total", r.instructions.total, "instructions executed");
@@ -158,20 +182,23 @@ void register_stats(const RenderResult& r, stats::Registry& reg) {
     if (r.timing) {
         r.timing->chip->register_stats(reg);
         if (reg.contains("rays/total"))
-            reg.add_derived("chip/rays_per_second",
-                            [&reg] {
-                                const double seconds = reg.value("chip/frame_seconds");
-                                return seconds > 0 ? reg.value("rays/total") / seconds : 0.0;
-                            },
-                            "rays traced per simulated second (rays/total / chip/frame_seconds)",
-                            "rays/s");
+            reg.add_derived(
+                "chip/rays_per_second",
+                [&reg] {
+                    const double seconds = reg.value("chip/frame_seconds");
+                    return seconds > 0 ? reg.value("rays/total") / seconds : 0.0;
+                },
+                "rays traced per simulated second (rays/total / chip/frame_seconds)", "rays/s");
     }
-    number("host/load_seconds", [&r] { return r.load_seconds; }, "scene load and import time", "s");
-    number("host/run_seconds", [&r] { return r.run_seconds; }, "kernel run time on the host", "s");
+    number(
+        "host/load_seconds", [&r] { return r.load_seconds; }, "scene load and import time", "s");
+    number(
+        "host/run_seconds", [&r] { return r.run_seconds; }, "kernel run time on the host", "s");
     if (r.instructions.total > 0)
-        number("host/simulated_instructions_per_second",
-               [&r] { return r.run_seconds > 0 ? double(r.instructions.total) / r.run_seconds : 0.0; },
-               "simulation speed", "instr/s");
+        number(
+            "host/simulated_instructions_per_second",
+            [&r] { return r.run_seconds > 0 ? double(r.instructions.total) / r.run_seconds : 0.0; },
+            "simulation speed", "instr/s");
 }
 
 void print_summary(const RenderOptions& options, const RenderResult& r, std::ostream& out) {
@@ -194,7 +221,8 @@ void print_summary(const RenderOptions& options, const RenderResult& r, std::ost
     fmt::print(out, "config   {}\n",
                changed.empty() ? "the defaults (configs/trax.toml)"
                                : "the defaults (configs/trax.toml) except " + changed);
-    fmt::print(out, "memory   {:.1f} KiB ({:.1f} KiB read-only scene):", double(r.image.bytes()) / 1024,
+    fmt::print(out,
+               "memory   {:.1f} KiB ({:.1f} KiB read-only scene):", double(r.image.bytes()) / 1024,
                double(r.image.read_only_bytes()) / 1024);
     const char* separator = " ";
     for (const image::SectionSize& s : r.image.sections)
@@ -204,14 +232,16 @@ void print_summary(const RenderOptions& options, const RenderResult& r, std::ost
         }
     fmt::print(out, "\n");
     if (r.bvh)
-        fmt::print(out, "bvh      {} nodes, {} leaves, depth {}, SAH cost {:.2f}, built in {:.3f} s{}\n",
+        fmt::print(out,
+                   "bvh      {} nodes, {} leaves, depth {}, SAH cost {:.2f}, built in {:.3f} s{}\n",
                    r.bvh->nodes, r.bvh->leaves, r.bvh->max_depth, r.bvh->sah_cost, r.bvh_seconds,
                    r.bvh->depth_limited_nodes
                        ? fmt::format(" (depth limit shaped {} nodes)", r.bvh->depth_limited_nodes)
                        : "");
     if (r.traversal.rays() > 0)
-        fmt::print(out, "rays     {} ({} primary, {} shadow): {:.1f} nodes, {:.1f} triangles per ray, "
-                        "stack depth up to {}\n",
+        fmt::print(out,
+                   "rays     {} ({} primary, {} shadow): {:.1f} nodes, {:.1f} triangles per ray, "
+                   "stack depth up to {}\n",
                    r.traversal.rays(), r.traversal.primary_rays, r.traversal.shadow_rays,
                    double(r.traversal.nodes_visited) / double(r.traversal.rays()),
                    double(r.traversal.triangles_tested) / double(r.traversal.rays()),
@@ -219,16 +249,18 @@ void print_summary(const RenderOptions& options, const RenderResult& r, std::ost
     if (r.timing) {
         const timing::Chip& chip = *r.timing->chip;
         const double seconds = double(chip.cycles()) / (options.chip.chip.clock_mhz * 1e6);
-        fmt::print(out, "timing   {} cycles = {:.3f} ms at {} MHz ({:.1f} frames/s), {:.2f} "
-                        "instructions per TP-cycle{}\n",
+        fmt::print(out,
+                   "timing   {} cycles = {:.3f} ms at {} MHz ({:.1f} frames/s), {:.2f} "
+                   "instructions per TP-cycle{}\n",
                    chip.cycles(), seconds * 1e3, options.chip.chip.clock_mhz, 1 / seconds,
                    double(r.instructions.total) / (double(chip.cycles()) * r.threads),
-                   r.traversal.rays() > 0
-                       ? fmt::format(", {:.1f} M rays/s", double(r.traversal.rays()) / seconds / 1e6)
-                       : "");
+                   r.traversal.rays() > 0 ? fmt::format(", {:.1f} M rays/s",
+                                                        double(r.traversal.rays()) / seconds / 1e6)
+                                          : "");
     }
     if (r.instructions.total > 0)
-        fmt::print(out, "run      {} instructions in {:.3f} s = {:.1f} M simulated instructions/s\n",
+        fmt::print(out,
+                   "run      {} instructions in {:.3f} s = {:.1f} M simulated instructions/s\n",
                    r.instructions.total, r.run_seconds,
                    double(r.instructions.total) / r.run_seconds / 1e6);
     else
@@ -239,9 +271,8 @@ nlohmann::ordered_json stats_document(const RenderOptions& options, const Render
                                       const stats::Snapshot& snapshot,
                                       const std::filesystem::path& json_path,
                                       const OutputPaths& outputs) {
-    const std::filesystem::path base = json_path.has_parent_path()
-                                           ? json_path.parent_path()
-                                           : std::filesystem::path(".");
+    const std::filesystem::path base =
+        json_path.has_parent_path() ? json_path.parent_path() : std::filesystem::path(".");
     const auto relative = [&](const std::filesystem::path& path) {
         return std::filesystem::proximate(path, base).generic_string();
     };

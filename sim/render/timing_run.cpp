@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cstring>
 
-
 namespace tpsim::render {
 
 std::shared_ptr<TimingRun> run_timing(const core::Program& program, image::MemoryImage& image,

@@ -5,13 +5,13 @@
 #include <filesystem>
 #include <memory>
 
-#include "render.hpp"
-#include "timeline.hpp"
-#include "sim/core/machine.hpp"
 #include "kernel/memory_map.hpp"
+#include "render.hpp"
+#include "sim/core/machine.hpp"
 #include "sim/image/memory_image.hpp"
 #include "sim/timing/chip.hpp"
 #include "sim/timing/machine_source.hpp"
+#include "timeline.hpp"
 
 namespace tpsim::render {
 
@@ -32,10 +32,9 @@ inline timing::ChipLayout chip_layout(const image::MemoryImage& image,
     timing::ChipLayout layout;
     for (const image::SectionSize& section : image.sections)
         if (section.bytes != 0)
-            layout.regions.push_back({section.name,
-                                      uint32_t(trax::map::kGlobalBase + section.begin),
-                                      uint32_t(trax::map::kGlobalBase + section.begin +
-                                               section.bytes)});
+            layout.regions.push_back(
+                {section.name, uint32_t(trax::map::kGlobalBase + section.begin),
+                 uint32_t(trax::map::kGlobalBase + section.begin + section.bytes)});
     // The kernel's own ELF image (constants in .rodata, .data, .bss): below the global memory.
     const auto& segments = machine.program().segments;
     if (!segments.empty())
@@ -43,16 +42,16 @@ inline timing::ChipLayout chip_layout(const image::MemoryImage& image,
     layout.text_base = machine.text_base();
     layout.text_words = machine.text_words();
     const auto& header = image.header;
-    layout.work_items = uint32_t(header.rays.count > 0 ? header.rays.count
-                                                       : header.framebuffer.count);
+    layout.work_items =
+        uint32_t(header.rays.count > 0 ? header.rays.count : header.framebuffer.count);
     return layout;
 }
 
 /// How a cycle-level run is watched while it runs.
 struct TimingRunOptions {
     uint64_t max_instructions = uint64_t(1) << 32;  ///< per thread, for runaway kernels
-    uint64_t pixels = 0;           ///< scales the progress reports (0: none)
-    ProgressCallback on_progress;  ///< every timing::Chip::kProgressInterval cycles
+    uint64_t pixels = 0;                            ///< scales the progress reports (0: none)
+    ProgressCallback on_progress;    ///< every timing::Chip::kProgressInterval cycles
     uint64_t timeline_interval = 0;  ///< cycles between timeline samples; 0: adapt (Timeline)
     /// Collect the chip's per-instruction profile (Chip::profile(); about 11 % slower).
     bool profile = false;

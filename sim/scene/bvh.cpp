@@ -42,7 +42,8 @@ struct Box {
 
 /// Most triangles a subtree can hold when its leaves may sit at most `levels` below its root.
 uint64_t subtree_capacity(uint32_t max_leaf_size, uint32_t levels) {
-    return levels >= 40 ? std::numeric_limits<uint64_t>::max() / 2 : uint64_t{max_leaf_size} << levels;
+    return levels >= 40 ? std::numeric_limits<uint64_t>::max() / 2
+                        : uint64_t{max_leaf_size} << levels;
 }
 
 /// A candidate object split. cost = A(left) * n_left + A(right) * n_right, i.e. the SAH without
@@ -60,7 +61,9 @@ struct Split {
 /// such trees shallow; then the earlier candidate, so the result never depends on anything else.
 bool better(const Split& candidate, const Split& incumbent, uint32_t count) {
     if (candidate.cost != incumbent.cost) return candidate.cost < incumbent.cost;
-    const auto imbalance = [&](const Split& s) { return std::abs(2 * int64_t(s.left_count) - int64_t(count)); };
+    const auto imbalance = [&](const Split& s) {
+        return std::abs(2 * int64_t(s.left_count) - int64_t(count));
+    };
     return imbalance(candidate) < imbalance(incumbent);
 }
 
@@ -93,12 +96,15 @@ protected:
                       const Split& feasible) {
         const bool fits_leaf = count <= config_.max_leaf_size;
         if (levels_left == 0) {
-            if (best.valid() && best.cost + node_area < double(count) * node_area) ++stats_.depth_limited_nodes;
+            if (best.valid() && best.cost + node_area < double(count) * node_area)
+                ++stats_.depth_limited_nodes;
             return {true, {}};
         }
-        if (fits_leaf && (!feasible.valid() || double(count) * node_area <= node_area + feasible.cost))
+        if (fits_leaf &&
+            (!feasible.valid() || double(count) * node_area <= node_area + feasible.cost))
             return {true, {}};
-        if (best.valid() && (!feasible.valid() || feasible.cost > best.cost)) ++stats_.depth_limited_nodes;
+        if (best.valid() && (!feasible.valid() || feasible.cost > best.cost))
+            ++stats_.depth_limited_nodes;
         return {false, feasible};
     }
 
@@ -130,7 +136,8 @@ public:
         for (int axis = 0; axis < 3; ++axis) {
             auto& order = order_[axis];
             order.resize(n);
-            for (uint32_t i = 0; i < n; ++i) order[i] = i;
+            for (uint32_t i = 0; i < n; ++i)
+                order[i] = i;
             // Index tie-break makes the order (and so the tree) independent of the sort algorithm.
             std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
                 const float ca = centroids_[a][axis], cb = centroids_[b][axis];
@@ -152,7 +159,8 @@ private:
     void build_node(uint32_t begin, uint32_t end, uint32_t levels_left) {
         const uint32_t count = end - begin;
         Box bounds;
-        for (uint32_t i = begin; i < end; ++i) bounds.grow(boxes_[order_[0][i]]);
+        for (uint32_t i = begin; i < end; ++i)
+            bounds.grow(boxes_[order_[0][i]]);
         const uint32_t index = emit_node(bounds);
 
         Split best, feasible;
@@ -170,7 +178,8 @@ private:
         build_node(middle, end, levels_left - 1);
     }
 
-    void find_splits(uint32_t begin, uint32_t end, uint64_t child_cap, Split& best, Split& feasible) {
+    void find_splits(uint32_t begin, uint32_t end, uint64_t child_cap, Split& best,
+                     Split& feasible) {
         const uint32_t count = end - begin;
         for (int axis = 0; axis < 3; ++axis) {
             const auto& order = order_[axis];
@@ -184,9 +193,11 @@ private:
                 left.grow(boxes_[order[i]]);
                 const uint32_t left_count = i + 1 - begin, right_count = count - left_count;
                 const Split candidate{axis, left_count, left_count,
-                                      double(left.area()) * left_count + double(right_area_[i + 1]) * right_count};
+                                      double(left.area()) * left_count +
+                                          double(right_area_[i + 1]) * right_count};
                 if (better(candidate, best, count)) best = candidate;
-                if (left_count <= child_cap && right_count <= child_cap && better(candidate, feasible, count))
+                if (left_count <= child_cap && right_count <= child_cap &&
+                    better(candidate, feasible, count))
                     feasible = candidate;
             }
         }
@@ -197,22 +208,25 @@ private:
     void partition(uint32_t begin, uint32_t end, const Split& split) {
         const uint32_t middle = begin + split.position;
         const auto& chosen = order_[split.axis];
-        for (uint32_t i = begin; i < end; ++i) goes_right_[chosen[i]] = i >= middle;
+        for (uint32_t i = begin; i < end; ++i)
+            goes_right_[chosen[i]] = i >= middle;
         for (int axis = 0; axis < 3; ++axis) {
             if (axis == split.axis) continue;
             auto& order = order_[axis];
             uint32_t left = begin, right = 0;
             for (uint32_t i = begin; i < end; ++i) {
                 const uint32_t t = order[i];
-                if (goes_right_[t]) scratch_[right++] = t;
-                else order[left++] = t;
+                if (goes_right_[t])
+                    scratch_[right++] = t;
+                else
+                    order[left++] = t;
             }
             std::copy(scratch_.begin(), scratch_.begin() + right, order.begin() + left);
         }
     }
 
     std::vector<uint32_t> order_[3];
-    std::vector<float> right_area_;   // right_area_[i]: area of the range's suffix from i
+    std::vector<float> right_area_;    // right_area_[i]: area of the range's suffix from i
     std::vector<uint8_t> goes_right_;  // per triangle, for the current partition
     std::vector<uint32_t> scratch_;
 };
@@ -227,7 +241,8 @@ public:
         sweep_.right_area.resize(bins_);
         sweep_.right_count.resize(bins_);
         order_.resize(triangles.size());
-        for (uint32_t i = 0; i < order_.size(); ++i) order_[i] = i;
+        for (uint32_t i = 0; i < order_.size(); ++i)
+            order_[i] = i;
     }
 
     Bvh build() {
@@ -257,16 +272,19 @@ private:
         const uint32_t index = emit_node(bounds);
 
         Split best, feasible;
-        if (count > 1) find_splits(begin, end, centroid_bounds, child_capacity(levels_left), best, feasible);
+        if (count > 1)
+            find_splits(begin, end, centroid_bounds, child_capacity(levels_left), best, feasible);
         NodeChoice choice = decide(count, bounds.area(), levels_left, best, feasible);
-        if (!choice.make_leaf && !choice.split.valid() && count <= config_.max_leaf_size) choice.make_leaf = true;
+        if (!choice.make_leaf && !choice.split.valid() && count <= config_.max_leaf_size)
+            choice.make_leaf = true;
         if (choice.make_leaf) {
             nodes_[index].first_triangle = begin;
             nodes_[index].triangle_count = count;
             return;
         }
-        const uint32_t middle = choice.split.valid() ? partition_by_bin(begin, end, centroid_bounds, choice.split)
-                                                     : partition_at_median(begin, end, centroid_bounds);
+        const uint32_t middle = choice.split.valid()
+                                    ? partition_by_bin(begin, end, centroid_bounds, choice.split)
+                                    : partition_at_median(begin, end, centroid_bounds);
         build_node(begin, middle, levels_left - 1);
         nodes_[index].right_child = uint32_t(nodes_.size());
         build_node(middle, end, levels_left - 1);
@@ -275,7 +293,8 @@ private:
     /// Bins per unit length on an axis, or 0 when the centroids cannot be binned along it.
     float bin_scale(int axis, const Box& centroid_bounds) const {
         const float scale = float(bins_) / (centroid_bounds.hi[axis] - centroid_bounds.lo[axis]);
-        return centroid_bounds.hi[axis] > centroid_bounds.lo[axis] && std::isfinite(scale) ? scale : 0.f;
+        return centroid_bounds.hi[axis] > centroid_bounds.lo[axis] && std::isfinite(scale) ? scale
+                                                                                           : 0.f;
     }
 
     uint32_t bin_of(uint32_t triangle, int axis, const Box& centroid_bounds, float scale) const {
@@ -283,8 +302,8 @@ private:
         return uint32_t(std::clamp(slot, 0.f, float(bins_ - 1)));
     }
 
-    void find_splits(uint32_t begin, uint32_t end, const Box& centroid_bounds, uint64_t child_cap, Split& best,
-                     Split& feasible) {
+    void find_splits(uint32_t begin, uint32_t end, const Box& centroid_bounds, uint64_t child_cap,
+                     Split& best, Split& feasible) {
         const uint32_t count = end - begin;
         auto& [bins, right_area, right_count] = sweep_;
         for (int axis = 0; axis < 3; ++axis) {
@@ -312,20 +331,24 @@ private:
                 const uint32_t right_n_here = right_count[b + 1];
                 if (left_n == 0 || right_n_here == 0) continue;
                 const Split candidate{axis, b + 1, left_n,
-                                      double(left.area()) * left_n + double(right_area[b + 1]) * right_n_here};
+                                      double(left.area()) * left_n +
+                                          double(right_area[b + 1]) * right_n_here};
                 if (better(candidate, best, count)) best = candidate;
-                if (left_n <= child_cap && right_n_here <= child_cap && better(candidate, feasible, count))
+                if (left_n <= child_cap && right_n_here <= child_cap &&
+                    better(candidate, feasible, count))
                     feasible = candidate;
             }
         }
     }
 
-    uint32_t partition_by_bin(uint32_t begin, uint32_t end, const Box& centroid_bounds, const Split& split) {
+    uint32_t partition_by_bin(uint32_t begin, uint32_t end, const Box& centroid_bounds,
+                              const Split& split) {
         const float scale = bin_scale(split.axis, centroid_bounds);
         // std::partition is not stable but is a pure function of its input: still deterministic.
-        const auto middle = std::partition(order_.begin() + begin, order_.begin() + end, [&](uint32_t t) {
-            return bin_of(t, split.axis, centroid_bounds, scale) < split.position;
-        });
+        const auto middle =
+            std::partition(order_.begin() + begin, order_.begin() + end, [&](uint32_t t) {
+                return bin_of(t, split.axis, centroid_bounds, scale) < split.position;
+            });
         return uint32_t(middle - order_.begin());
     }
 
@@ -333,7 +356,8 @@ private:
     /// centroids in one bin): half the triangles by centroid on the widest axis.
     uint32_t partition_at_median(uint32_t begin, uint32_t end, const Box& centroid_bounds) {
         const glm::vec3 extent = centroid_bounds.hi - centroid_bounds.lo;
-        const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
+        const int axis =
+            extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
         const uint32_t middle = begin + (end - begin) / 2;
         std::nth_element(order_.begin() + begin, order_.begin() + middle, order_.begin() + end,
                          [&](uint32_t a, uint32_t b) {
@@ -353,24 +377,31 @@ constexpr float kMaxCoordinate = 1e18f;
 
 void validate(std::span<const Triangle> triangles, const BvhConfig& config) {
     if (config.max_leaf_size < 1 || config.max_leaf_size > 8)
-        throw std::invalid_argument(fmt::format("BVH: max_leaf_size must be in 1..8, got {}", config.max_leaf_size));
+        throw std::invalid_argument(
+            fmt::format("BVH: max_leaf_size must be in 1..8, got {}", config.max_leaf_size));
     if (config.bins < 2 || config.bins > 256)
-        throw std::invalid_argument(fmt::format("BVH: bins must be in 2..256, got {}", config.bins));
-    if (triangles.empty()) throw std::invalid_argument("BVH: the scene has no triangles; add a mesh or generator");
+        throw std::invalid_argument(
+            fmt::format("BVH: bins must be in 2..256, got {}", config.bins));
+    if (triangles.empty())
+        throw std::invalid_argument("BVH: the scene has no triangles; add a mesh or generator");
     if (triangles.size() > (size_t{1} << 31))
-        throw std::invalid_argument(fmt::format("BVH: {} triangles exceed the 2^31 limit", triangles.size()));
-    const uint64_t capacity = subtree_capacity(config.max_leaf_size, config.traversal_stack_entries);
+        throw std::invalid_argument(
+            fmt::format("BVH: {} triangles exceed the 2^31 limit", triangles.size()));
+    const uint64_t capacity =
+        subtree_capacity(config.max_leaf_size, config.traversal_stack_entries);
     if (triangles.size() > capacity)
-        throw std::invalid_argument(fmt::format(
-            "BVH: {} triangles cannot fit in leaves of {} at depth <= {}; raise traversal_stack_entries",
-            triangles.size(), config.max_leaf_size, config.traversal_stack_entries));
+        throw std::invalid_argument(fmt::format("BVH: {} triangles cannot fit in leaves of {} at "
+                                                "depth <= {}; raise traversal_stack_entries",
+                                                triangles.size(), config.max_leaf_size,
+                                                config.traversal_stack_entries));
     for (size_t i = 0; i < triangles.size(); ++i) {
         const Triangle& t = triangles[i];
         for (const glm::vec3& v : {t.v0, t.v1, t.v2})
             if (!glm::all(glm::lessThanEqual(glm::abs(v), glm::vec3(kMaxCoordinate))))
-                throw std::invalid_argument(fmt::format(
-                    "BVH: triangle {} has vertex ({}, {}, {}); coordinates must be finite and within +-{:g}", i, v.x,
-                    v.y, v.z, kMaxCoordinate));
+                throw std::invalid_argument(
+                    fmt::format("BVH: triangle {} has vertex ({}, {}, {}); coordinates must be "
+                                "finite and within +-{:g}",
+                                i, v.x, v.y, v.z, kMaxCoordinate));
     }
 }
 
@@ -406,7 +437,8 @@ double sah_cost(const Bvh& bvh) {
         return root_area > 0.0 ? double(node.bounds.surface_area()) / root_area : 1.0;
     };
     double sum = 0.0;
-    for (const BvhNode& node : bvh.nodes) sum += ratio(node) * (node.is_leaf() ? double(node.triangle_count) : 1.0);
+    for (const BvhNode& node : bvh.nodes)
+        sum += ratio(node) * (node.is_leaf() ? double(node.triangle_count) : 1.0);
     return sum;
 }
 
@@ -415,7 +447,8 @@ Bvh build_bvh(std::span<const Triangle> triangles, const BvhConfig& config) {
     const auto start = std::chrono::steady_clock::now();
     Bvh bvh = config.builder == BvhBuilder::sweep ? SweepBuilder(triangles, config).build()
                                                   : BinnedBuilder(triangles, config).build();
-    bvh.stats.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    bvh.stats.build_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     fill_shape_stats(bvh, config.max_leaf_size, bvh.stats);
     return bvh;
 }

@@ -29,8 +29,11 @@ struct Interval {
         return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
     }
     std::string text() const {
-        const auto bound = [](double v) { return std::isinf(v) ? std::string(v < 0 ? "-inf" : "inf") : fmt::format("{}", v); };
-        return fmt::format("{}{}, {}{}", lo_open ? '(' : '[', bound(lo), bound(hi), hi_open ? ')' : ']');
+        const auto bound = [](double v) {
+            return std::isinf(v) ? std::string(v < 0 ? "-inf" : "inf") : fmt::format("{}", v);
+        };
+        return fmt::format("{}{}, {}{}", lo_open ? '(' : '[', bound(lo), bound(hi),
+                           hi_open ? ')' : ']');
     }
 };
 constexpr Interval kAnyFinite{};
@@ -40,13 +43,20 @@ constexpr Interval kUnit{0, 1, false, false};
 
 std::string_view type_name(const toml::node& node) {
     switch (node.type()) {
-        case toml::node_type::table: return "table";
-        case toml::node_type::array: return "array";
-        case toml::node_type::string: return "string";
-        case toml::node_type::integer: return "integer";
-        case toml::node_type::floating_point: return "float";
-        case toml::node_type::boolean: return "boolean";
-        default: return "date/time";
+    case toml::node_type::table:
+        return "table";
+    case toml::node_type::array:
+        return "array";
+    case toml::node_type::string:
+        return "string";
+    case toml::node_type::integer:
+        return "integer";
+    case toml::node_type::floating_point:
+        return "float";
+    case toml::node_type::boolean:
+        return "boolean";
+    default:
+        return "date/time";
     }
 }
 
@@ -61,7 +71,8 @@ public:
     explicit Reader(std::string file) : file_(std::move(file)) {}
 
     [[noreturn]] void fail(const toml::source_region& where, std::string_view message) const {
-        throw SceneError(fmt::format("{}:{}:{}: {}", file_, where.begin.line, where.begin.column, message));
+        throw SceneError(
+            fmt::format("{}:{}:{}: {}", file_, where.begin.line, where.begin.column, message));
     }
 
     const std::string& file() const { return file_; }
@@ -77,17 +88,23 @@ public:
     }
 
     double number(const toml::node& node, const std::string& name, const Interval& allowed) const {
-        if (!node.is_number()) fail(node.source(), fmt::format("{} must be a number, got a {}", name, type_name(node)));
+        if (!node.is_number())
+            fail(node.source(),
+                 fmt::format("{} must be a number, got a {}", name, type_name(node)));
         const double v = *node.value<double>();
         if (!std::isfinite(v) || !allowed.contains(v))
             fail(node.source(), fmt::format("{} must be in {}, got {}", name, allowed.text(), v));
         return v;
     }
 
-    uint32_t integer(const toml::node& node, const std::string& name, uint32_t lo, uint32_t hi) const {
-        if (!node.is_integer()) fail(node.source(), fmt::format("{} must be an integer, got a {}", name, type_name(node)));
+    uint32_t integer(const toml::node& node, const std::string& name, uint32_t lo,
+                     uint32_t hi) const {
+        if (!node.is_integer())
+            fail(node.source(),
+                 fmt::format("{} must be an integer, got a {}", name, type_name(node)));
         const int64_t v = *node.value<int64_t>();
-        if (v < lo || v > hi) fail(node.source(), fmt::format("{} must be in [{}, {}], got {}", name, lo, hi, v));
+        if (v < lo || v > hi)
+            fail(node.source(), fmt::format("{} must be in [{}, {}], got {}", name, lo, hi, v));
         return uint32_t(v);
     }
 
@@ -98,60 +115,69 @@ public:
         if (array == nullptr || array->size() != size)
             fail(node.source(), fmt::format("{} must be an array of {} numbers", name, size));
         std::vector<double> values;
-        for (size_t i = 0; i < size; ++i) values.push_back(number((*array)[i], fmt::format("{}[{}]", name, i), allowed));
+        for (size_t i = 0; i < size; ++i)
+            values.push_back(number((*array)[i], fmt::format("{}[{}]", name, i), allowed));
         return values;
     }
 
-    glm::vec3 vec3(const toml::node& node, const std::string& name, const Interval& allowed = kAnyFinite) const {
+    glm::vec3 vec3(const toml::node& node, const std::string& name,
+                   const Interval& allowed = kAnyFinite) const {
         const auto v = numbers(node, name, 3, allowed);
         return {float(v[0]), float(v[1]), float(v[2])};
     }
 
-    const toml::node& required(const toml::table& table, std::string_view prefix, std::string_view key) const {
+    const toml::node& required(const toml::table& table, std::string_view prefix,
+                               std::string_view key) const {
         const toml::node* node = table.get(key);
         if (node == nullptr) fail(table.source(), fmt::format("{} is required", join(prefix, key)));
         return *node;
     }
 
     // Optional fields: the fallback when the key is absent.
-    double number(const toml::table& t, std::string_view prefix, std::string_view key, const Interval& allowed,
-                  double fallback) const {
+    double number(const toml::table& t, std::string_view prefix, std::string_view key,
+                  const Interval& allowed, double fallback) const {
         const toml::node* node = t.get(key);
         return node ? number(*node, join(prefix, key), allowed) : fallback;
     }
-    uint32_t integer(const toml::table& t, std::string_view prefix, std::string_view key, uint32_t lo, uint32_t hi,
-                     uint32_t fallback) const {
+    uint32_t integer(const toml::table& t, std::string_view prefix, std::string_view key,
+                     uint32_t lo, uint32_t hi, uint32_t fallback) const {
         const toml::node* node = t.get(key);
         return node ? integer(*node, join(prefix, key), lo, hi) : fallback;
     }
-    glm::vec3 vec3(const toml::table& t, std::string_view prefix, std::string_view key, const Interval& allowed,
-                   glm::vec3 fallback) const {
+    glm::vec3 vec3(const toml::table& t, std::string_view prefix, std::string_view key,
+                   const Interval& allowed, glm::vec3 fallback) const {
         const toml::node* node = t.get(key);
         return node ? vec3(*node, join(prefix, key), allowed) : fallback;
     }
 
-    bool boolean(const toml::table& t, std::string_view prefix, std::string_view key, bool fallback) const {
+    bool boolean(const toml::table& t, std::string_view prefix, std::string_view key,
+                 bool fallback) const {
         const toml::node* node = t.get(key);
         if (node == nullptr) return fallback;
         if (!node->is_boolean())
-            fail(node->source(), fmt::format("{} must be true or false, got a {}", join(prefix, key), type_name(*node)));
+            fail(node->source(), fmt::format("{} must be true or false, got a {}",
+                                             join(prefix, key), type_name(*node)));
         return *node->value<bool>();
     }
 
     std::string text(const toml::node& node, const std::string& name) const {
-        if (!node.is_string()) fail(node.source(), fmt::format("{} must be a string, got a {}", name, type_name(node)));
+        if (!node.is_string())
+            fail(node.source(),
+                 fmt::format("{} must be a string, got a {}", name, type_name(node)));
         return std::string(*node.value<std::string_view>());
     }
 
     const toml::table& table(const toml::node& node, const std::string& name) const {
-        if (!node.is_table()) fail(node.source(), fmt::format("{} must be a table, got a {}", name, type_name(node)));
+        if (!node.is_table())
+            fail(node.source(), fmt::format("{} must be a table, got a {}", name, type_name(node)));
         return *node.as_table();
     }
 
     /// `[[name]]` entries (or an inline array of tables).
     std::vector<const toml::table*> tables(const toml::node& node, const std::string& name) const {
         const toml::array* array = node.as_array();
-        if (array == nullptr) fail(node.source(), fmt::format("{} must be an array of tables ([[{}]])", name, name));
+        if (array == nullptr)
+            fail(node.source(), fmt::format("{} must be an array of tables ([[{}]])", name, name));
         std::vector<const toml::table*> result;
         for (size_t i = 0; i < array->size(); ++i)
             result.push_back(&table((*array)[i], fmt::format("{}[{}]", name, i)));
@@ -212,7 +238,8 @@ Camera read_camera(const Reader& r, const toml::table& t) {
     camera.eye = r.vec3(r.required(t, "camera", "eye"), "camera.eye");
     camera.look_at = r.vec3(r.required(t, "camera", "look_at"), "camera.look_at");
     camera.up = r.vec3(t, "camera", "up", kAnyFinite, camera.up);
-    camera.vertical_fov_degrees = float(r.number(t, "camera", "fov", Interval{0, 180, true, true}, 45.0));
+    camera.vertical_fov_degrees =
+        float(r.number(t, "camera", "fov", Interval{0, 180, true, true}, 45.0));
     const glm::vec3 view = camera.look_at - camera.eye;
     if (glm::length(view) == 0.f) r.fail(t.source(), "camera.eye and camera.look_at must differ");
     if (glm::length(camera.up) == 0.f ||
@@ -228,7 +255,8 @@ std::vector<PointLight> read_lights(const Reader& r, const toml::node& node) {
         const std::string prefix = fmt::format("lights[{}]", i);
         const toml::table& t = *tables[i];
         r.allow_keys(t, prefix, {"position", "color", "intensity"});
-        const glm::vec3 position = r.vec3(r.required(t, prefix, "position"), join(prefix, "position"));
+        const glm::vec3 position =
+            r.vec3(r.required(t, prefix, "position"), join(prefix, "position"));
         const glm::vec3 color = r.vec3(t, prefix, "color", kNonNegative, glm::vec3(1.f));
         const float intensity = float(r.number(t, prefix, "intensity", kNonNegative, 1.0));
         lights.push_back({position, color * intensity});
@@ -236,13 +264,15 @@ std::vector<PointLight> read_lights(const Reader& r, const toml::node& node) {
     return lights;
 }
 
-std::optional<uint32_t> read_material_ref(const Reader& r, const toml::table& t, const std::string& prefix,
+std::optional<uint32_t> read_material_ref(const Reader& r, const toml::table& t,
+                                          const std::string& prefix,
                                           const MaterialTable& materials) {
     const toml::node* node = t.get("material");
     if (node == nullptr) return std::nullopt;
     const std::string name = r.text(*node, join(prefix, "material"));
     if (auto index = materials.defined(name)) return index;
-    r.fail(node->source(), fmt::format("{}.material '{}' is not defined in [materials]", prefix, name));
+    r.fail(node->source(),
+           fmt::format("{}.material '{}' is not defined in [materials]", prefix, name));
 }
 
 glm::mat4 read_transform(const Reader& r, const toml::table& t, const std::string& prefix) {
@@ -251,9 +281,11 @@ glm::mat4 read_transform(const Reader& r, const toml::table& t, const std::strin
         const std::string name = join(prefix, "scale");
         const Interval allowed{1e-30, 1e30, false, false};
         // A negative or zero scale would mirror or flatten the mesh: almost always a typo.
-        scale = node->is_array() ? r.vec3(*node, name, allowed) : glm::vec3(float(r.number(*node, name, allowed)));
+        scale = node->is_array() ? r.vec3(*node, name, allowed)
+                                 : glm::vec3(float(r.number(*node, name, allowed)));
     }
-    const glm::vec3 rotate = r.vec3(t, prefix, "rotate", Interval{-360, 360, false, false}, glm::vec3(0.f));
+    const glm::vec3 rotate =
+        r.vec3(t, prefix, "rotate", Interval{-360, 360, false, false}, glm::vec3(0.f));
     const glm::vec3 translate = r.vec3(t, prefix, "translate", kAnyFinite, glm::vec3(0.f));
     // Applied to the mesh in this order: scale, rotate about x, then y, then z, translate.
     glm::mat4 m = glm::translate(glm::mat4(1.f), translate);
@@ -263,8 +295,8 @@ glm::mat4 read_transform(const Reader& r, const toml::table& t, const std::strin
     return glm::scale(m, scale);
 }
 
-void read_mesh(const Reader& r, const toml::table& t, const std::string& prefix, const std::filesystem::path& base,
-               MaterialTable& materials, Scene& scene) {
+void read_mesh(const Reader& r, const toml::table& t, const std::string& prefix,
+               const std::filesystem::path& base, MaterialTable& materials, Scene& scene) {
     r.allow_keys(t, prefix, {"path", "scale", "rotate", "translate", "material"});
     const toml::node& path_node = r.required(t, prefix, "path");
     const std::filesystem::path path = base / r.text(path_node, join(prefix, "path"));
@@ -278,36 +310,45 @@ void read_mesh(const Reader& r, const toml::table& t, const std::string& prefix,
         r.fail(path_node.source(), fmt::format("{}: {}", join(prefix, "path"), e.what()));
     }
     if (scene.triangles.size() + mesh.triangles.size() > kMaxTriangles)
-        r.fail(t.source(), fmt::format("{} would take the scene past {} triangles", prefix, kMaxTriangles));
+        r.fail(t.source(),
+               fmt::format("{} would take the scene past {} triangles", prefix, kMaxTriangles));
     std::vector<uint32_t> file_to_scene;
-    for (const Material& m : mesh.materials) file_to_scene.push_back(material ? *material : materials.intern(m));
+    for (const Material& m : mesh.materials)
+        file_to_scene.push_back(material ? *material : materials.intern(m));
     const auto apply = [&](const glm::vec3& v) { return glm::vec3(transform * glm::vec4(v, 1.f)); };
     for (const Triangle& t : mesh.triangles)
-        scene.triangles.push_back({apply(t.v0), apply(t.v1), apply(t.v2), file_to_scene[t.material]});
+        scene.triangles.push_back(
+            {apply(t.v0), apply(t.v1), apply(t.v2), file_to_scene[t.material]});
     scene.sources.push_back(mesh.summary);
 }
 
 SphereParams read_sphere_shape(const Reader& r, const toml::table& t, const std::string& prefix) {
     SphereParams sphere;
-    sphere.radius = float(r.number(r.required(t, prefix, "radius"), join(prefix, "radius"), kPositive));
+    sphere.radius =
+        float(r.number(r.required(t, prefix, "radius"), join(prefix, "radius"), kPositive));
     sphere.segments = r.integer(t, prefix, "segments", 3, 4096, sphere.segments);
     sphere.rings = r.integer(t, prefix, "rings", 2, 4096, sphere.rings);
     return sphere;
 }
 
-glm::uvec2 read_uvec2(const Reader& r, const toml::node& node, const std::string& name, uint32_t lo, uint32_t hi) {
+glm::uvec2 read_uvec2(const Reader& r, const toml::node& node, const std::string& name, uint32_t lo,
+                      uint32_t hi) {
     const toml::array* array = node.as_array();
-    if (array == nullptr || array->size() != 2) r.fail(node.source(), fmt::format("{} must be an array of 2 integers", name));
-    return {r.integer((*array)[0], name + "[0]", lo, hi), r.integer((*array)[1], name + "[1]", lo, hi)};
+    if (array == nullptr || array->size() != 2)
+        r.fail(node.source(), fmt::format("{} must be an array of 2 integers", name));
+    return {r.integer((*array)[0], name + "[0]", lo, hi),
+            r.integer((*array)[1], name + "[1]", lo, hi)};
 }
 
-void read_generator(const Reader& r, const toml::table& t, const std::string& prefix, MaterialTable& materials,
-                    Scene& scene) {
+void read_generator(const Reader& r, const toml::table& t, const std::string& prefix,
+                    MaterialTable& materials, Scene& scene) {
     const std::string type = r.text(r.required(t, prefix, "type"), join(prefix, "type"));
-    const uint32_t material = read_material_ref(r, t, prefix, materials).value_or(materials.intern(kDefaultMaterial));
+    const uint32_t material =
+        read_material_ref(r, t, prefix, materials).value_or(materials.intern(kDefaultMaterial));
     const auto check_size = [&](uint64_t adding) {
         if (scene.triangles.size() + adding > kMaxTriangles)
-            r.fail(t.source(), fmt::format("{} adds {} triangles, taking the scene past {}", prefix, adding, kMaxTriangles));
+            r.fail(t.source(), fmt::format("{} adds {} triangles, taking the scene past {}", prefix,
+                                           adding, kMaxTriangles));
     };
     const size_t first = scene.triangles.size();
     if (type == "sphere") {
@@ -324,25 +365,32 @@ void read_generator(const Reader& r, const toml::table& t, const std::string& pr
             const auto v = r.numbers(*size, join(prefix, "size"), 2, kPositive);
             terrain.size = {float(v[0]), float(v[1])};
         }
-        if (const toml::node* cells = t.get("cells")) terrain.cells = read_uvec2(r, *cells, join(prefix, "cells"), 1, 16384);
+        if (const toml::node* cells = t.get("cells"))
+            terrain.cells = read_uvec2(r, *cells, join(prefix, "cells"), 1, 16384);
         terrain.height = float(r.number(t, prefix, "height", kNonNegative, terrain.height));
         terrain.seed = r.integer(t, prefix, "seed", 0, UINT32_MAX, terrain.seed);
         check_size(uint64_t{2} * terrain.cells.x * terrain.cells.y);
         generate_terrain(terrain, material, scene.triangles);
     } else if (type == "sphere_grid") {
-        r.allow_keys(t, prefix, {"type", "material", "center", "count", "spacing", "radius", "segments", "rings"});
+        r.allow_keys(
+            t, prefix,
+            {"type", "material", "center", "count", "spacing", "radius", "segments", "rings"});
         SphereGridParams grid;
         grid.sphere = read_sphere_shape(r, t, prefix);
         grid.center = r.vec3(r.required(t, prefix, "center"), join(prefix, "center"));
         grid.count = read_uvec2(r, r.required(t, prefix, "count"), join(prefix, "count"), 1, 4096);
-        grid.spacing = float(r.number(r.required(t, prefix, "spacing"), join(prefix, "spacing"), kPositive));
-        check_size(uint64_t{2} * grid.count.x * grid.count.y * grid.sphere.segments * grid.sphere.rings);
+        grid.spacing =
+            float(r.number(r.required(t, prefix, "spacing"), join(prefix, "spacing"), kPositive));
+        check_size(uint64_t{2} * grid.count.x * grid.count.y * grid.sphere.segments *
+                   grid.sphere.rings);
         generate_sphere_grid(grid, material, scene.triangles);
     } else {
         r.fail(r.required(t, prefix, "type").source(),
-               fmt::format("{}.type must be one of sphere, terrain, sphere_grid, got '{}'", prefix, type));
+               fmt::format("{}.type must be one of sphere, terrain, sphere_grid, got '{}'", prefix,
+                           type));
     }
-    scene.sources.push_back({fmt::format("generator {} ({})", type, prefix), scene.triangles.size() - first, 0, 0});
+    scene.sources.push_back(
+        {fmt::format("generator {} ({})", type, prefix), scene.triangles.size() - first, 0, 0});
 }
 
 }  // namespace
@@ -360,7 +408,8 @@ Aabb bounds_of(std::span<const Triangle> triangles) {
 Camera frame_bounds(const Aabb& bounds, float aspect) {
     Camera camera;
     const glm::vec3 center = 0.5f * (bounds.lo + bounds.hi);
-    const float radius = std::max(0.5f * glm::length(bounds.hi - bounds.lo), 1e-6f * std::max(1.f, glm::length(center)));
+    const float radius = std::max(0.5f * glm::length(bounds.hi - bounds.lo),
+                                  1e-6f * std::max(1.f, glm::length(center)));
     // The sphere must fit the narrower of the two fields of view; 5% margin around it.
     const float half_vertical = glm::radians(camera.vertical_fov_degrees) * 0.5f;
     const float half_horizontal = std::atan(std::tan(half_vertical) * aspect);
@@ -374,7 +423,8 @@ Camera frame_bounds(const Aabb& bounds, float aspect) {
 PointLight default_light(const Camera& camera, const Aabb& bounds, bool light_falloff) {
     const glm::vec3 center = 0.5f * (bounds.lo + bounds.hi);
     const float distance = glm::length(camera.eye - center);
-    const glm::vec3 position = camera.eye + glm::vec3(0.f, 0.5f * distance, 0.f) + 0.25f * (camera.eye - center);
+    const glm::vec3 position =
+        camera.eye + glm::vec3(0.f, 0.5f * distance, 0.f) + 0.25f * (camera.eye - center);
     const glm::vec3 to_center = position - center;
     return {position, glm::vec3(light_falloff ? glm::dot(to_center, to_center) : 1.f)};
 }
@@ -408,8 +458,9 @@ Scene load_scene_file(const std::filesystem::path& toml_path) {
     } catch (const toml::parse_error& e) {
         r.fail(e.source(), fmt::format("TOML syntax: {}", e.description()));
     }
-    r.allow_keys(root, "", {"name", "image", "shading", "camera", "ambient", "background", "lights", "materials", "meshes",
-                            "generators"});
+    r.allow_keys(root, "",
+                 {"name", "image", "shading", "camera", "ambient", "background", "lights",
+                  "materials", "meshes", "generators"});
     Scene scene;
     scene.name = root.get("name") ? r.text(*root.get("name"), "name") : toml_path.stem().string();
     if (const toml::node* node = root.get("image")) {
@@ -417,7 +468,8 @@ Scene load_scene_file(const std::filesystem::path& toml_path) {
         r.allow_keys(image, "image", {"width", "height", "samples_per_pixel"});
         scene.width = r.integer(image, "image", "width", 1, 16384, scene.width);
         scene.height = r.integer(image, "image", "height", 1, 16384, scene.height);
-        scene.samples_per_pixel = r.integer(image, "image", "samples_per_pixel", 1, 65536, scene.samples_per_pixel);
+        scene.samples_per_pixel =
+            r.integer(image, "image", "samples_per_pixel", 1, 65536, scene.samples_per_pixel);
     }
     if (const toml::node* node = root.get("shading")) {
         const toml::table& shading = r.table(*node, "shading");
@@ -431,12 +483,14 @@ Scene load_scene_file(const std::filesystem::path& toml_path) {
     MaterialTable materials;
     if (const toml::node* node = root.get("materials"))
         for (auto&& [name, value] : r.table(*node, "materials"))
-            materials.define({std::string(name.str()), r.vec3(value, join("materials", name.str()), kUnit)});
+            materials.define(
+                {std::string(name.str()), r.vec3(value, join("materials", name.str()), kUnit)});
 
     // Camera and lights are read before the geometry so their mistakes are reported even when
     // a mesh is missing too; their defaults need the geometry's bounds, so they come last.
     std::optional<Camera> camera;
-    if (const toml::node* node = root.get("camera")) camera = read_camera(r, r.table(*node, "camera"));
+    if (const toml::node* node = root.get("camera"))
+        camera = read_camera(r, r.table(*node, "camera"));
     std::optional<std::vector<PointLight>> lights;
     if (const toml::node* node = root.get("lights")) lights = read_lights(r, *node);
 
@@ -451,20 +505,24 @@ Scene load_scene_file(const std::filesystem::path& toml_path) {
         for (size_t i = 0; i < generators.size(); ++i)
             read_generator(r, *generators[i], fmt::format("generators[{}]", i), materials, scene);
     }
-    if (scene.triangles.empty()) r.fail(root.source(), "the scene has no geometry; add [[meshes]] or [[generators]]");
+    if (scene.triangles.empty())
+        r.fail(root.source(), "the scene has no geometry; add [[meshes]] or [[generators]]");
     keep_used_materials(scene, materials.list());
 
     const Aabb bounds = bounds_of(scene.triangles);
-    scene.camera = camera ? *camera : frame_bounds(bounds, float(scene.width) / float(scene.height));
-    scene.lights = lights ? *lights : std::vector{default_light(scene.camera, bounds, scene.light_falloff)};
+    scene.camera =
+        camera ? *camera : frame_bounds(bounds, float(scene.width) / float(scene.height));
+    scene.lights =
+        lights ? *lights : std::vector{default_light(scene.camera, bounds, scene.light_falloff)};
     return scene;
 }
 
 Scene load_scene(const std::filesystem::path& path) {
     if (path.extension() == ".toml") return load_scene_file(path);
     if (is_mesh_file(path)) return scene_from_mesh(path);
-    throw SceneError(fmt::format("{}: not a scene file (.toml) nor a mesh format assimp reads (.obj, .ply, .off, ...)",
-                                 path.string()));
+    throw SceneError(fmt::format(
+        "{}: not a scene file (.toml) nor a mesh format assimp reads (.obj, .ply, .off, ...)",
+        path.string()));
 }
 
 }  // namespace tpsim::scene

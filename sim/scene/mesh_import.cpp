@@ -21,14 +21,17 @@ bool is_degenerate(const Triangle& t) {
     return n.x == 0.f && n.y == 0.f && n.z == 0.f;
 }
 
-bool is_finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool is_finite(const glm::vec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 
 Material convert_material(const aiMaterial& source) {
     Material material;
     aiString name;
     if (source.Get(AI_MATKEY_NAME, name) == AI_SUCCESS) material.name = name.C_Str();
     aiColor3D diffuse;
-    if (source.Get(AI_MATKEY_COLOR_DIFFUSE, diffuse) == AI_SUCCESS) material.diffuse = {diffuse.r, diffuse.g, diffuse.b};
+    if (source.Get(AI_MATKEY_COLOR_DIFFUSE, diffuse) == AI_SUCCESS)
+        material.diffuse = {diffuse.r, diffuse.g, diffuse.b};
     return material;
 }
 
@@ -36,7 +39,8 @@ Material convert_material(const aiMaterial& source) {
 size_t ply_type_size(const std::string& type) {
     if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
     if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
-    if (type == "int" || type == "uint" || type == "float" || type == "int32" || type == "uint32" || type == "float32")
+    if (type == "int" || type == "uint" || type == "float" || type == "int32" || type == "uint32" ||
+        type == "float32")
         return 4;
     if (type == "double" || type == "float64") return 8;
     return 0;
@@ -49,7 +53,8 @@ void check_ply_complete(const std::filesystem::path& path) {
     std::ifstream in(path, std::ios::binary);
     const std::string where = path.string();
     const auto fail = [&](const std::string& why) {
-        throw std::runtime_error(fmt::format("{}: malformed or truncated PLY file: {}", where, why));
+        throw std::runtime_error(
+            fmt::format("{}: malformed or truncated PLY file: {}", where, why));
     };
     struct Property {
         size_t size = 0, count_size = 0;  // count_size != 0: a list
@@ -65,7 +70,8 @@ void check_ply_complete(const std::filesystem::path& path) {
         std::istringstream words(line);
         std::string word;
         words >> word;
-        if (word == "format") words >> format;
+        if (word == "format")
+            words >> format;
         else if (word == "element") {
             elements.emplace_back();
             std::string name;
@@ -90,7 +96,8 @@ void check_ply_complete(const std::filesystem::path& path) {
     }
     if (!ended) fail("no end_header");
     const bool ascii = format == "ascii";
-    if (!ascii && format != "binary_little_endian" && format != "binary_big_endian") fail("unknown format '" + format + "'");
+    if (!ascii && format != "binary_little_endian" && format != "binary_big_endian")
+        fail("unknown format '" + format + "'");
     if (ascii) {
         std::string token;
         for (const Element& element : elements)
@@ -134,14 +141,18 @@ ImportedMesh import_mesh(const std::filesystem::path& path) {
     const std::string where = path.string();
     std::error_code error;
     if (!std::filesystem::is_regular_file(path, error))
-        throw std::runtime_error(fmt::format("{}: mesh file not found (paths in scene files are relative to the "
-                                             "scene file)", where));
+        throw std::runtime_error(
+            fmt::format("{}: mesh file not found (paths in scene files are relative to the "
+                        "scene file)",
+                        where));
     if (!is_mesh_file(path))
-        throw std::runtime_error(fmt::format("{}: '{}' is not a mesh format assimp reads (try .obj, .ply, .off)",
-                                             where, path.extension().string()));
+        throw std::runtime_error(
+            fmt::format("{}: '{}' is not a mesh format assimp reads (try .obj, .ply, .off)", where,
+                        path.extension().string()));
 
     std::string extension = path.extension().string();
-    std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return std::tolower(c); });
     if (extension == ".ply") check_ply_complete(path);
 
     Assimp::Importer importer;
@@ -149,19 +160,23 @@ ImportedMesh import_mesh(const std::filesystem::path& path) {
     // a later step (Debian's assimp keeps its asserts; e.g. an OFF file with a missing face list).
     // PreTransformVertices bakes node transforms in. FindDegenerates is deliberately absent:
     // degenerate triangles stay in as a robustness test for the kernels.
-    const aiScene* file = importer.ReadFile(
-        where, aiProcess_ValidateDataStructure | aiProcess_Triangulate | aiProcess_PreTransformVertices);
+    const aiScene* file =
+        importer.ReadFile(where, aiProcess_ValidateDataStructure | aiProcess_Triangulate |
+                                     aiProcess_PreTransformVertices);
     if (file == nullptr)
-        throw std::runtime_error(fmt::format("{}: cannot read mesh: {}", where, importer.GetErrorString()));
+        throw std::runtime_error(
+            fmt::format("{}: cannot read mesh: {}", where, importer.GetErrorString()));
 
     ImportedMesh mesh;
     mesh.summary.source = where;
-    for (unsigned m = 0; m < file->mNumMaterials; ++m) mesh.materials.push_back(convert_material(*file->mMaterials[m]));
+    for (unsigned m = 0; m < file->mNumMaterials; ++m)
+        mesh.materials.push_back(convert_material(*file->mMaterials[m]));
     if (mesh.materials.empty()) mesh.materials.push_back(Material{"default", glm::vec3(0.8f)});
 
     for (unsigned m = 0; m < file->mNumMeshes; ++m) {
         const aiMesh& part = *file->mMeshes[m];
-        const uint32_t material = part.mMaterialIndex < mesh.materials.size() ? part.mMaterialIndex : 0;
+        const uint32_t material =
+            part.mMaterialIndex < mesh.materials.size() ? part.mMaterialIndex : 0;
         for (unsigned f = 0; f < part.mNumFaces; ++f) {
             const aiFace& face = part.mFaces[f];
             if (face.mNumIndices != 3) {
@@ -171,12 +186,14 @@ ImportedMesh import_mesh(const std::filesystem::path& path) {
             glm::vec3 corners[3];
             for (int k = 0; k < 3; ++k) {
                 if (face.mIndices[k] >= part.mNumVertices)
-                    throw std::runtime_error(fmt::format("{}: face {} of mesh {} refers to vertex {} of {}", where, f,
-                                                         m, face.mIndices[k], part.mNumVertices));
+                    throw std::runtime_error(
+                        fmt::format("{}: face {} of mesh {} refers to vertex {} of {}", where, f, m,
+                                    face.mIndices[k], part.mNumVertices));
                 const aiVector3D& p = part.mVertices[face.mIndices[k]];
                 corners[k] = {p.x, p.y, p.z};
                 if (!is_finite(corners[k]))
-                    throw std::runtime_error(fmt::format("{}: face {} of mesh {} has a non-finite vertex", where, f, m));
+                    throw std::runtime_error(
+                        fmt::format("{}: face {} of mesh {} has a non-finite vertex", where, f, m));
             }
             const Triangle triangle{corners[0], corners[1], corners[2], material};
             if (is_degenerate(triangle)) ++mesh.summary.degenerate_triangles;
@@ -185,9 +202,10 @@ ImportedMesh import_mesh(const std::filesystem::path& path) {
     }
     mesh.summary.triangles = mesh.triangles.size();
     if (mesh.triangles.empty())
-        throw std::runtime_error(fmt::format("{}: the file holds no triangles ({} meshes, {} points/lines); is it "
-                                             "empty or in another format than its extension says?",
-                                             where, file->mNumMeshes, mesh.summary.skipped_primitives));
+        throw std::runtime_error(
+            fmt::format("{}: the file holds no triangles ({} meshes, {} points/lines); is it "
+                        "empty or in another format than its extension says?",
+                        where, file->mNumMeshes, mesh.summary.skipped_primitives));
     return mesh;
 }
 

@@ -8,8 +8,8 @@
 namespace tpsim::scene {
 
 struct ImportedMesh {
-    std::vector<Triangle> triangles;   ///< Triangle::material indexes `materials` below
-    std::vector<Material> materials;   ///< as named in the file (assimp's default if none)
+    std::vector<Triangle> triangles;  ///< Triangle::material indexes `materials` below
+    std::vector<Material> materials;  ///< as named in the file (assimp's default if none)
     SourceSummary summary;
 };
 

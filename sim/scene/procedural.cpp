@@ -18,7 +18,9 @@ float lattice_value(int32_t x, int32_t z, uint32_t seed) {
     return float(h >> 8) * (1.f / 16777216.f);
 }
 
-float smooth(float t) { return t * t * (3.f - 2.f * t); }
+float smooth(float t) {
+    return t * t * (3.f - 2.f * t);
+}
 
 /// Value noise in [0, 1): hashed lattice values blended with a smoothstep.
 float value_noise(float x, float z, uint32_t seed) {
@@ -36,7 +38,8 @@ float value_noise(float x, float z, uint32_t seed) {
 void generate_sphere(const SphereParams& p, uint32_t material, std::vector<Triangle>& out) {
     const auto point = [&](uint32_t ring, uint32_t segment) {
         const float theta = std::numbers::pi_v<float> * float(ring) / float(p.rings);
-        const float phi = 2.f * std::numbers::pi_v<float> * float(segment % p.segments) / float(p.segments);
+        const float phi =
+            2.f * std::numbers::pi_v<float> * float(segment % p.segments) / float(p.segments);
         return p.center + p.radius * glm::vec3(std::sin(theta) * std::cos(phi), std::cos(theta),
                                                std::sin(theta) * std::sin(phi));
     };
@@ -73,19 +76,24 @@ void generate_terrain(const TerrainParams& p, uint32_t material, std::vector<Tri
     out.reserve(out.size() + size_t{2} * p.cells.x * p.cells.y);
     for (uint32_t j = 0; j < p.cells.y; ++j)
         for (uint32_t i = 0; i < p.cells.x; ++i) {
-            const glm::vec3 a = vertex(i, j), b = vertex(i + 1, j), c = vertex(i, j + 1), d = vertex(i + 1, j + 1);
+            const glm::vec3 a = vertex(i, j), b = vertex(i + 1, j), c = vertex(i, j + 1),
+                            d = vertex(i + 1, j + 1);
             out.push_back({a, c, b, material});
             out.push_back({b, c, d, material});
         }
 }
 
-void generate_sphere_grid(const SphereGridParams& p, uint32_t material, std::vector<Triangle>& out) {
-    out.reserve(out.size() + size_t{2} * p.count.x * p.count.y * p.sphere.segments * (p.sphere.rings - 1));
-    const glm::vec2 first = glm::vec2(p.center.x, p.center.z) - 0.5f * p.spacing * glm::vec2(p.count - 1u);
+void generate_sphere_grid(const SphereGridParams& p, uint32_t material,
+                          std::vector<Triangle>& out) {
+    out.reserve(out.size() +
+                size_t{2} * p.count.x * p.count.y * p.sphere.segments * (p.sphere.rings - 1));
+    const glm::vec2 first =
+        glm::vec2(p.center.x, p.center.z) - 0.5f * p.spacing * glm::vec2(p.count - 1u);
     for (uint32_t j = 0; j < p.count.y; ++j)
         for (uint32_t i = 0; i < p.count.x; ++i) {
             SphereParams sphere = p.sphere;
-            sphere.center = {first.x + p.spacing * float(i), p.center.y, first.y + p.spacing * float(j)};
+            sphere.center = {first.x + p.spacing * float(i), p.center.y,
+                             first.y + p.spacing * float(j)};
             generate_sphere(sphere, material, out);
         }
 }

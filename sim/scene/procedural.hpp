@@ -20,10 +20,10 @@ struct SphereParams {
 /// Height field over the xz plane: 2 * cells.x * cells.y triangles. Heights are fractal value
 /// noise from an integer hash (no libm), so they are identical on every host.
 struct TerrainParams {
-    glm::vec3 center{0.f};    ///< the terrain's mean height is center.y
-    glm::vec2 size{100.f};    ///< extent along x and z
-    glm::uvec2 cells{100};    ///< grid cells along x and z, >= 1
-    float height = 5.f;       ///< peak-to-peak amplitude (at most)
+    glm::vec3 center{0.f};  ///< the terrain's mean height is center.y
+    glm::vec2 size{100.f};  ///< extent along x and z
+    glm::uvec2 cells{100};  ///< grid cells along x and z, >= 1
+    float height = 5.f;     ///< peak-to-peak amplitude (at most)
     uint32_t seed = 1;
 };
 
@@ -37,7 +37,8 @@ struct SphereGridParams {
 
 void generate_sphere(const SphereParams& params, uint32_t material, std::vector<Triangle>& out);
 void generate_terrain(const TerrainParams& params, uint32_t material, std::vector<Triangle>& out);
-void generate_sphere_grid(const SphereGridParams& params, uint32_t material, std::vector<Triangle>& out);
+void generate_sphere_grid(const SphereGridParams& params, uint32_t material,
+                          std::vector<Triangle>& out);
 
 /// The terrain's height at (x, z) in world space, for placing things on it.
 float terrain_height(const TerrainParams& params, float x, float z);

@@ -34,10 +34,10 @@ struct Camera {
 
 /// What one mesh file or generator contributed, so the caller can print an import summary.
 struct SourceSummary {
-    std::string source;                   ///< mesh path or "generator <type>"
-    uint64_t triangles = 0;               ///< triangles added to Scene::triangles
-    uint64_t degenerate_triangles = 0;    ///< of those, with zero area (kept on purpose)
-    uint64_t skipped_primitives = 0;      ///< points and lines in the file, not imported
+    std::string source;                 ///< mesh path or "generator <type>"
+    uint64_t triangles = 0;             ///< triangles added to Scene::triangles
+    uint64_t degenerate_triangles = 0;  ///< of those, with zero area (kept on purpose)
+    uint64_t skipped_primitives = 0;    ///< points and lines in the file, not imported
 };
 
 struct Scene {
@@ -50,8 +50,8 @@ struct Scene {
     glm::vec3 background{0.f};
     uint32_t width = 256, height = 256;
     uint32_t samples_per_pixel = 1;
-    bool shadows = true;        ///< cast a shadow ray to every light
-    bool light_falloff = true;  ///< light intensity falls off with the squared distance
+    bool shadows = true;                 ///< cast a shadow ray to every light
+    bool light_falloff = true;           ///< light intensity falls off with the squared distance
     std::vector<SourceSummary> sources;  ///< in the order they were loaded
 };
 

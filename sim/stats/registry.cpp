@@ -50,9 +50,8 @@ void Registry::add(Entry entry) {
             "statistic name '{}' is malformed: use '/'-separated segments of [A-Za-z0-9_.-]",
             entry.name));
     if (contains(entry.name))
-        throw std::invalid_argument(
-            fmt::format("statistic '{}' is registered twice: register each counter once",
-                        entry.name));
+        throw std::invalid_argument(fmt::format(
+            "statistic '{}' is registered twice: register each counter once", entry.name));
     entries_.push_back(std::move(entry));
 }
 
@@ -73,9 +72,8 @@ void Registry::add_derived(std::string name, std::function<double()> derive,
     add({std::move(name), std::move(description), std::move(unit), {}, std::move(derive)});
 }
 
-void Registry::add_ratio(std::string name, std::string_view numerator,
-                         std::string_view denominator, std::string description,
-                         std::string unit) {
+void Registry::add_ratio(std::string name, std::string_view numerator, std::string_view denominator,
+                         std::string description, std::string unit) {
     // Copy the accessors so the ratio stays valid however entries_ grows.
     const Entry num = at(numerator);
     const Entry den = at(denominator);
@@ -94,15 +92,18 @@ void Registry::add_sum(std::string name, std::string_view pattern, std::string d
     for (const Entry& e : entries_)
         if (matches(pattern, e.name)) parts.push_back(e);
     if (parts.empty())
-        throw std::invalid_argument(fmt::format(
-            "statistic sum '{}': no registered statistic matches '{}'", name, pattern));
+        throw std::invalid_argument(
+            fmt::format("statistic sum '{}': no registered statistic matches '{}'", name, pattern));
     const bool all_integer =
         std::all_of(parts.begin(), parts.end(), [](const Entry& e) { return e.is_integer(); });
     if (all_integer) {
-        add({std::move(name), std::move(description), std::move(unit),
+        add({std::move(name),
+             std::move(description),
+             std::move(unit),
              [parts] {
                  uint64_t sum = 0;
-                 for (const Entry& e : parts) sum += e.integer();
+                 for (const Entry& e : parts)
+                     sum += e.integer();
                  return sum;
              },
              {}});
@@ -111,7 +112,8 @@ void Registry::add_sum(std::string name, std::string_view pattern, std::string d
             std::move(name),
             [parts] {
                 double sum = 0;
-                for (const Entry& e : parts) sum += e.value();
+                for (const Entry& e : parts)
+                    sum += e.value();
                 return sum;
             },
             std::move(description), std::move(unit));
@@ -149,14 +151,15 @@ const Value& Snapshot::at(std::string_view name) const {
 
 Snapshot Snapshot::since(const Snapshot& earlier) const {
     if (earlier.values_.size() != values_.size())
-        throw std::invalid_argument("Snapshot::since: the snapshots come from different registries");
+        throw std::invalid_argument(
+            "Snapshot::since: the snapshots come from different registries");
     Snapshot interval = *this;
     for (size_t i = 0; i < values_.size(); ++i) {
         Value& v = interval.values_[i];
         if (earlier.values_[i].name != v.name)
-            throw std::invalid_argument(fmt::format(
-                "Snapshot::since: '{}' against '{}': different registries", v.name,
-                earlier.values_[i].name));
+            throw std::invalid_argument(
+                fmt::format("Snapshot::since: '{}' against '{}': different registries", v.name,
+                            earlier.values_[i].name));
         if (v.is_integer)
             v.integer -= earlier.values_[i].integer;
         else

@@ -17,9 +17,9 @@ namespace tpsim::stats {
 /// One registered statistic: an integer (counters and sums of counters, printed exactly) or a
 /// real number (ratios, rates, host time). Values are read when printed, never cached.
 struct Entry {
-    std::string name;         ///< hierarchical, '/'-separated, e.g. "tm0/l1/hits"
-    std::string description;  ///< one line, shown in the text report
-    std::string unit;         ///< e.g. "cycles", "B/cycle"; empty if dimensionless
+    std::string name;                   ///< hierarchical, '/'-separated, e.g. "tm0/l1/hits"
+    std::string description;            ///< one line, shown in the text report
+    std::string unit;                   ///< e.g. "cycles", "B/cycle"; empty if dimensionless
     std::function<uint64_t()> integer;  ///< set for integer entries
     std::function<double()> real;       ///< set for real entries
 

@@ -25,8 +25,7 @@ inline void clear_bit(std::vector<uint64_t>& bits, uint32_t i) {
 }
 
 /// Calls f(i) for each set bit of `word`, lowest first; i counts from bit 0 of word `w`.
-template <class F>
-void for_each_bit(uint32_t w, uint64_t word, F&& f) {
+template <class F> void for_each_bit(uint32_t w, uint64_t word, F&& f) {
     for (; word != 0; word &= word - 1)
         f((w << 6) + static_cast<uint32_t>(std::countr_zero(word)));
 }

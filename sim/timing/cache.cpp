@@ -10,15 +10,11 @@
 namespace tpsim::timing {
 
 Cache::Cache(const CacheConfig& config, uint32_t write_combining_lines)
-    : config_(config),
-      num_sets_(config.size_bytes / (config.ways * config.line_bytes)),
+    : config_(config), num_sets_(config.size_bytes / (config.ways * config.line_bytes)),
       line_shift_(static_cast<uint32_t>(std::countr_zero(config.line_bytes))),
-      bank_mod_(config.banks),
-      set_mod_(std::max(num_sets_, 1u)),
-      ways_(size_t{num_sets_} * config.ways),
-      mshrs_(config.mshrs),
-      bank_used_at_(config.banks, UINT64_MAX),
-      combining_capacity_(write_combining_lines) {
+      bank_mod_(config.banks), set_mod_(std::max(num_sets_, 1u)),
+      ways_(size_t{num_sets_} * config.ways), mshrs_(config.mshrs),
+      bank_used_at_(config.banks, UINT64_MAX), combining_capacity_(write_combining_lines) {
     if (num_sets_ == 0 || (config.line_bytes & (config.line_bytes - 1)) != 0)
         throw std::invalid_argument(
             "Cache: invalid geometry; validate the ChipConfig before building caches");
@@ -35,11 +31,14 @@ const Cache::Way* Cache::find(uint32_t line) const {
     return const_cast<Cache*>(this)->find(line);
 }
 
-bool Cache::contains(uint32_t addr) const { return find(line_of(addr)) != nullptr; }
+bool Cache::contains(uint32_t addr) const {
+    return find(line_of(addr)) != nullptr;
+}
 
 uint32_t Cache::outstanding_misses() const {
     uint32_t n = 0;
-    for (const Mshr& m : mshrs_) n += m.busy;
+    for (const Mshr& m : mshrs_)
+        n += m.busy;
     return n;
 }
 
@@ -104,7 +103,8 @@ CacheOutcome Cache::access(uint64_t now, const MemRequest& request) {
 CacheOutcome Cache::combine(uint64_t at, const MemRequest& request) {
     const uint32_t line = line_of(request.addr);
     size_t index = 0;
-    while (index < combining_.size() && combining_[index].first.addr != line) ++index;
+    while (index < combining_.size() && combining_[index].first.addr != line)
+        ++index;
     if (index == combining_.size()) {
         if (combining_.size() == combining_capacity_) {
             write_line(0, at);  // the oldest line makes room
@@ -133,7 +133,8 @@ void Cache::write_line(size_t index, uint64_t at) {
 
 bool Cache::drain_write_buffer(uint64_t now) {
     const bool any = !combining_.empty();
-    while (!combining_.empty()) write_line(0, now);
+    while (!combining_.empty())
+        write_line(0, now);
     return any;
 }
 
@@ -154,7 +155,8 @@ void Cache::fill(uint64_t now, uint32_t line_addr) {
     }
     for (Mshr& m : mshrs_) {
         if (!m.busy || m.line != line) continue;
-        for (const MemRequest& waiter : m.waiters) replies_.push_back({now + config_.hit_latency, waiter});
+        for (const MemRequest& waiter : m.waiters)
+            replies_.push_back({now + config_.hit_latency, waiter});
         m.waiters.clear();
         m.busy = false;
     }

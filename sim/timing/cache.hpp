@@ -36,13 +36,13 @@ private:
 };
 
 enum class CacheOutcome : uint8_t {
-    Hit,           ///< reply queued for now + hit_latency
-    Miss,          ///< a line request went to the next level
-    MergedMiss,    ///< joined an outstanding miss to the same line
-    WriteForward,  ///< store accepted and forwarded (write-around)
-    WriteCombined, ///< store accepted into the write-combining buffer
-    BankConflict,  ///< bank already used this cycle: nothing happened, retry next cycle
-    MshrFull,      ///< no MSHR free: nothing happened, retry later
+    Hit,            ///< reply queued for now + hit_latency
+    Miss,           ///< a line request went to the next level
+    MergedMiss,     ///< joined an outstanding miss to the same line
+    WriteForward,   ///< store accepted and forwarded (write-around)
+    WriteCombined,  ///< store accepted into the write-combining buffer
+    BankConflict,   ///< bank already used this cycle: nothing happened, retry next cycle
+    MshrFull,       ///< no MSHR free: nothing happened, retry later
 };
 
 inline bool accepted(CacheOutcome o) {
@@ -52,8 +52,8 @@ inline bool accepted(CacheOutcome o) {
 class Cache {
 public:
     struct Counters {
-        uint64_t reads = 0;           ///< accepted loads (= hits + misses + merged_misses)
-        uint64_t writes = 0;          ///< accepted stores
+        uint64_t reads = 0;   ///< accepted loads (= hits + misses + merged_misses)
+        uint64_t writes = 0;  ///< accepted stores
         uint64_t hits = 0;
         uint64_t misses = 0;          ///< loads that sent a line request to the next level
         uint64_t merged_misses = 0;   ///< loads that joined an outstanding miss
@@ -126,11 +126,11 @@ private:
     uint32_t line_shift_;  // log2(line_bytes), validated a power of two
     Modulus bank_mod_;
     Modulus set_mod_;
-    std::vector<Way> ways_;               // num_sets_ x ways
+    std::vector<Way> ways_;  // num_sets_ x ways
     std::vector<Mshr> mshrs_;
     std::vector<uint64_t> bank_used_at_;  // last cycle each bank accepted an access
     uint64_t use_clock_ = 0;
-    std::deque<MemReply> replies_;        // non-decreasing `ready`
+    std::deque<MemReply> replies_;  // non-decreasing `ready`
     std::deque<OutboundRequest> outbound_;
     uint32_t combining_capacity_;
     std::vector<CombiningLine> combining_;  // oldest first
@@ -186,7 +186,7 @@ private:
     };
     Modulus bank_mod_;                  // banks per I-cache
     std::vector<uint32_t> first_bank_;  // per thread: index of its I-cache's bank 0
-    std::vector<Bank> banks_;  // all I-caches of the TM, banks_per_icache_ each
+    std::vector<Bank> banks_;           // all I-caches of the TM, banks_per_icache_ each
     Counters counters_;
 };
 

@@ -10,8 +10,8 @@
 
 #include <algorithm>
 #include <bit>
-#include <utility>
 #include <stdexcept>
+#include <utility>
 
 namespace tpsim::timing {
 
@@ -22,13 +22,16 @@ constexpr uint64_t kDeadlockCycles = 1'000'000;
 constexpr size_t kPools = static_cast<size_t>(Pool::Count);
 constexpr size_t kStalls = static_cast<size_t>(Stall::Count);
 
-bool is_local(uint32_t addr) { return addr >= trax::map::kLocalTop - trax::map::kStackGuard; }
+bool is_local(uint32_t addr) {
+    return addr >= trax::map::kLocalTop - trax::map::kStackGuard;
+}
 
 /// The longest a TP can sleep until a known cycle: an operand wait (at most the longest FU
 /// latency plus the local-store latency) or a branch bubble.
 uint64_t longest_timed_sleep(const ChipConfig& c) {
     uint64_t fu = 0;
-    for (size_t p = 0; p < kPools; ++p) fu = std::max<uint64_t>(fu, pool_config(c.fu, Pool(p)).latency);
+    for (size_t p = 0; p < kPools; ++p)
+        fu = std::max<uint64_t>(fu, pool_config(c.fu, Pool(p)).latency);
     const uint64_t bubble = std::max(c.tp.branch_taken_penalty, c.tp.branch_not_taken_penalty);
     return std::max(fu + c.tp.local_store_latency, bubble + 1);
 }
@@ -39,10 +42,18 @@ void count_access(LevelTraffic& t, CacheOutcome outcome, uint64_t payload, uint6
     t.payload_bytes += payload;
     t.moved_bytes += moved;
     switch (outcome) {
-    case CacheOutcome::Hit: ++t.reads, ++t.hits; break;
-    case CacheOutcome::Miss: ++t.reads, ++t.misses; break;
-    case CacheOutcome::MergedMiss: ++t.reads, ++t.merged_misses; break;
-    default: ++t.writes; break;  // WriteForward, WriteCombined
+    case CacheOutcome::Hit:
+        ++t.reads, ++t.hits;
+        break;
+    case CacheOutcome::Miss:
+        ++t.reads, ++t.misses;
+        break;
+    case CacheOutcome::MergedMiss:
+        ++t.reads, ++t.merged_misses;
+        break;
+    default:
+        ++t.writes;
+        break;  // WriteForward, WriteCombined
     }
 }
 
@@ -56,12 +67,12 @@ struct Chip::Tm {
     // i of word i / 64); the rest of a TP's state is in Tp.
     using TpBits = std::vector<uint64_t>;
     struct Tp {
-        StepInfo pending;            // fetched, not yet issued (bit in pending_tps)
+        StepInfo pending;  // fetched, not yet issued (bit in pending_tps)
         Pool pending_pool{};
-        Pool asleep_on{};            // the producing pool a reply-wait is attributed to
-        uint64_t wake_at = 0;        // asleep until this cycle (kNever: until a reply for it)
-        uint64_t asleep_from = 0;    // first uncounted cycle of a reply-wait
-        uint64_t mem_at = 0;         // a granted load/store's first cycle at the L1
+        Pool asleep_on{};          // the producing pool a reply-wait is attributed to
+        uint64_t wake_at = 0;      // asleep until this cycle (kNever: until a reply for it)
+        uint64_t asleep_from = 0;  // first uncounted cycle of a reply-wait
+        uint64_t mem_at = 0;       // a granted load/store's first cycle at the L1
         MemRequest mem_request;
         uint32_t lowest_local = trax::map::kLocalTop;  // for the local-store high-water mark
         // The work item held (the last atomicinc(0) result; none before the first), since
@@ -72,7 +83,7 @@ struct Chip::Tm {
         // Cycle each register becomes readable; the extra last slot is isa::kNoReg (an unused
         // operand) and stays 0, so the scoreboard check needs no branch per operand.
         std::array<uint64_t, isa::kNumRegs + 1> reg_ready{};
-        std::array<Pool, isa::kNumRegs> reg_producer{};   // pool that will write it
+        std::array<Pool, isa::kNumRegs> reg_producer{};  // pool that will write it
     };
     struct Counters {
         uint64_t instructions = 0;
@@ -90,9 +101,10 @@ struct Chip::Tm {
           icache(c.icache, c.chip.tps_per_tm), l1(c.l1), awake_tps(words), pending_tps(words),
           needs_port_tps(words), mem_waiting_tps(words), issuing_tps(words), asking_tps(words),
           wheel_slots(std::min(std::bit_ceil(longest_timed_sleep(c) + 1), kMaxWheelSlots)),
-          sleeps_outlast_wheel(longest_timed_sleep(c) >= wheel_slots),
-          wheel(wheel_slots * words), l1_traffic(regions) {
-        for (uint32_t i = 0; i < c.chip.tps_per_tm; ++i) set_bit(awake_tps, i);
+          sleeps_outlast_wheel(longest_timed_sleep(c) >= wheel_slots), wheel(wheel_slots * words),
+          l1_traffic(regions) {
+        for (uint32_t i = 0; i < c.chip.tps_per_tm; ++i)
+            set_bit(awake_tps, i);
         for (size_t p = 0; p < kPools; ++p)
             pools.emplace_back(pool_config(c.fu, Pool(p)), c.chip.tps_per_tm);
     }
@@ -119,7 +131,8 @@ struct Chip::Tm {
     void sleep_until(uint32_t i, uint64_t at, uint64_t now) {
         tps[i].wake_at = at;
         clear_bit(awake_tps, i);
-        const uint64_t slot = (at - now < wheel_slots ? at : now + wheel_slots - 1) & (wheel_slots - 1);
+        const uint64_t slot =
+            (at - now < wheel_slots ? at : now + wheel_slots - 1) & (wheel_slots - 1);
         set_bit(wheel, uint32_t(slot) * 64 * words + i);
     }
     /// Start of cycle `now`: the TPs whose timed sleep ends join the awake set.
@@ -140,12 +153,12 @@ struct Chip::Tm {
     }
 
     uint32_t id;
-    uint32_t words;               // 64-bit words of a TpBits
+    uint32_t words;  // 64-bit words of a TpBits
     std::vector<Tp> tps;
     std::vector<FuPool> pools;
     ICacheBanks icache;
     Cache l1;
-    uint32_t rotation = 0;        // TP that goes first this cycle (fetch and L1 priority)
+    uint32_t rotation = 0;  // TP that goes first this cycle (fetch and L1 priority)
     uint32_t atomic_sequence = 0;
     std::vector<AtomicRequest> atomics_out;  // sent this cycle, collected by the chip
     uint32_t running = 0;
@@ -169,10 +182,7 @@ struct Chip::Tm {
 };
 
 Chip::Chip(const ChipConfig& config, InstructionSource& source, const ChipLayout& layout)
-    : config_(config),
-      layout_(layout),
-      source_(source),
-      dram_(config.dram, config.l2.line_bytes),
+    : config_(config), layout_(layout), source_(source), dram_(config.dram, config.l2.line_bytes),
       global_registers_(config.global_registers) {
     validate(config_);
     if (layout.regions.size() >= UINT8_MAX)
@@ -197,10 +207,10 @@ Chip::Chip(const ChipConfig& config, InstructionSource& source, const ChipLayout
               [](const RegionBounds& a, const RegionBounds& b) { return a.begin < b.begin; });
     for (size_t r = 1; r < region_bounds_.size(); ++r)
         if (region_bounds_[r].begin < region_bounds_[r - 1].end)
-            throw std::invalid_argument(fmt::format(
-                "Chip: regions '{}' and '{}' overlap",
-                layout.regions[region_bounds_[r - 1].index].name,
-                layout.regions[region_bounds_[r].index].name));
+            throw std::invalid_argument(
+                fmt::format("Chip: regions '{}' and '{}' overlap",
+                            layout.regions[region_bounds_[r - 1].index].name,
+                            layout.regions[region_bounds_[r].index].name));
     other_region_ = uint8_t(layout.regions.size());
     work_items_.items.resize(layout.work_items);
     if (layout.profile) profile_ = {layout.text_base, std::vector<PcCounters>(layout.text_words)};
@@ -209,8 +219,10 @@ Chip::Chip(const ChipConfig& config, InstructionSource& source, const ChipLayout
     l2_traffic_.resize(regions);
     dram_traffic_.resize(regions);
 
-    for (size_t fu = 0; fu < pool_of_.size(); ++fu) pool_of_[fu] = pool_of(isa::FuClass(fu));
-    for (size_t p = 0; p < kPools; ++p) latency_of_[p] = pool_config(config.fu, Pool(p)).latency;
+    for (size_t fu = 0; fu < pool_of_.size(); ++fu)
+        pool_of_[fu] = pool_of(isa::FuClass(fu));
+    for (size_t p = 0; p < kPools; ++p)
+        latency_of_[p] = pool_config(config.fu, Pool(p)).latency;
     for (uint32_t t = 0; t < config.chip.num_tms; ++t) {
         tms_.push_back(std::make_unique<Tm>(config, t, regions));
         tms_.back()->running = config.chip.tps_per_tm;
@@ -233,13 +245,14 @@ Chip::~Chip() {
     if (clocked_machine_) clocked_machine_->set_cycle_counter(nullptr);
 }
 
-bool Chip::run_until(uint64_t cycle) { return (this->*run_cycles_)(cycle); }
+bool Chip::run_until(uint64_t cycle) {
+    return (this->*run_cycles_)(cycle);
+}
 
 uint64_t Chip::run(uint64_t max_cycles) {
     if (!run_until(max_cycles))
         throw std::runtime_error(fmt::format(
-            "timing: the chip did not finish within {} cycles; raise the cycle limit",
-            max_cycles));
+            "timing: the chip did not finish within {} cycles; raise the cycle limit", max_cycles));
     return cycles_;
 }
 
@@ -252,16 +265,15 @@ bool Chip::busy() const {
 }
 
 bool Chip::drained() const {
-    return !busy() && std::none_of(l2s_.begin(), l2s_.end(), [](const Cache& l2) {
-        return l2.holds_combined_lines();
-    });
+    return !busy() && std::none_of(l2s_.begin(), l2s_.end(),
+                                   [](const Cache& l2) { return l2.holds_combined_lines(); });
 }
 
 uint8_t Chip::region_of(uint32_t addr) const {
     // The last region starting at or below addr, if addr is inside it.
-    const auto after = std::upper_bound(
-        region_bounds_.begin(), region_bounds_.end(), addr,
-        [](uint32_t a, const RegionBounds& r) { return a < r.begin; });
+    const auto after =
+        std::upper_bound(region_bounds_.begin(), region_bounds_.end(), addr,
+                         [](uint32_t a, const RegionBounds& r) { return a < r.begin; });
     if (after == region_bounds_.begin() || addr >= after[-1].end) return other_region_;
     return after[-1].index;
 }
@@ -279,20 +291,20 @@ void Chip::collect() {
         }
         local_payload_bytes_ += tm->counters.local_payload_bytes;
         for (const Tm::Tp& tp : tm->tps)
-            local_store_high_water_ = std::max<uint64_t>(local_store_high_water_,
-                                                         trax::map::kLocalTop - tp.lowest_local);
+            local_store_high_water_ =
+                std::max<uint64_t>(local_store_high_water_, trax::map::kLocalTop - tp.lowest_local);
     }
 }
 
-template <class Source>
-bool Chip::run_cycles(uint64_t end) {
+template <class Source> bool Chip::run_cycles(uint64_t end) {
     // The constructor chose Source to be the source's own type.
     Source& source = static_cast<Source&>(source_);
     for (uint64_t now = cycles_; now < end && !finished_; ++now) {
         if (!busy()) {
             // Every thread has exited: the write-combining buffers drain, then the chip is done.
             bool drained_lines = false;
-            for (Cache& l2 : l2s_) drained_lines |= l2.drain_write_buffer(now);
+            for (Cache& l2 : l2s_)
+                drained_lines |= l2.drain_write_buffer(now);
             if (!drained_lines) {
                 finished_ = true;
                 break;
@@ -327,7 +339,8 @@ bool Chip::run_cycles(uint64_t end) {
 
 uint32_t Chip::running_threads() const {
     uint32_t running = 0;
-    for (const auto& tm : tms_) running += tm->running;
+    for (const auto& tm : tms_)
+        running += tm->running;
     return running;
 }
 
@@ -341,7 +354,8 @@ void Chip::tick_shared(uint64_t now) {
         ++progress_;
     }
     for (Cache& l2 : l2s_)
-        while (l2.pop_reply(now, reply)) tms_[reply.request.source]->l1.fill(now, reply.request.addr);
+        while (l2.pop_reply(now, reply))
+            tms_[reply.request.source]->l1.fill(now, reply.request.addr);
 
     const uint32_t line_bytes = config_.l2.line_bytes;
     for (auto& tm : tms_) {
@@ -378,7 +392,8 @@ void Chip::tick_shared(uint64_t now) {
     }
     dram_.served().clear();
     for (auto& tm : tms_) {
-        for (const AtomicRequest& a : tm->atomics_out) global_registers_.submit(a);
+        for (const AtomicRequest& a : tm->atomics_out)
+            global_registers_.submit(a);
         tm->atomics_out.clear();
     }
     global_registers_.tick(now);
@@ -420,8 +435,8 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             if (!accepted(outcome)) continue;
             accessed |= uint64_t{1} << bit;
             const uint64_t moved = outcome == CacheOutcome::Miss ? tm.l1.config().line_bytes
-                                   : request.write                ? request.bytes
-                                                                  : 0;
+                                   : request.write               ? request.bytes
+                                                                 : 0;
             count_access(tm.l1_traffic[request.region], outcome, request.bytes, moved);
             if constexpr (kProfile)
                 profile_at(request.pc).l1_misses += outcome == CacheOutcome::Miss;
@@ -493,7 +508,8 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             const isa::Decoded& d = *tp.pending.insn;
             const std::array<uint8_t, 4> regs = {d.rs1, d.rs2, d.rs3, d.rd};
             uint64_t operands_at = 0;
-            for (uint8_t r : regs) operands_at = std::max(operands_at, tp.reg_ready[r]);
+            for (uint8_t r : regs)
+                operands_at = std::max(operands_at, tp.reg_ready[r]);
             Pool blocking = Pool::IntAlu;  // producer of the first operand that is ready last
             for (uint8_t r : regs)
                 if (r != isa::kNoReg && tp.reg_ready[r] == operands_at) {
@@ -578,8 +594,9 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             } else if (s.mem_bytes != 0) {
                 set_bit(tm.mem_waiting_tps, i);
                 tp.mem_at = ready;
-                tp.mem_request = {s.mem_address, i, d.rd, s.mem_store,
-                                  region_of(s.mem_address), s.mem_bytes, s.pc, tp.item};
+                tp.mem_request = {
+                    s.mem_address, i,    d.rd,   s.mem_store, region_of(s.mem_address),
+                    s.mem_bytes,   s.pc, tp.item};
                 result_at = kNever;  // set by the L1 reply
             }
             if (d.rd != isa::kNoReg && !s.mem_store) {
@@ -592,8 +609,8 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
                 charge_item(tp.item, now + 1 - tp.item_since, tp.item_instructions);
             } else if (fu == isa::FuClass::Branch) {
                 // The bubble after a branch: no fetch before now + 1 + bubble.
-                const uint32_t bubble = s.taken ? config_.tp.branch_taken_penalty
-                                                : config_.tp.branch_not_taken_penalty;
+                const uint32_t bubble =
+                    s.taken ? config_.tp.branch_taken_penalty : config_.tp.branch_not_taken_penalty;
                 if (bubble != 0) {
                     counters.active_tp_cycles += bubble;
                     counters.stalls[size_t(Stall::Branch)] += bubble;
@@ -622,8 +639,7 @@ void Chip::register_stats(stats::Registry& r) const {
         const std::string p = fmt::format("tm{}", tm.id);
         r.add_counter(p + "/instructions", tm.counters.instructions, "instructions issued");
         r.add_counter(p + "/active_tp_cycles", tm.counters.active_tp_cycles,
-                      "TP-cycles of threads that had not exited (= issued + stalled)",
-                      "TP-cycles");
+                      "TP-cycles of threads that had not exited (= issued + stalled)", "TP-cycles");
         for (size_t s = 0; s < kStalls; ++s)
             r.add_counter(fmt::format("{}/stalls/{}", p, kStallNames[s]), tm.counters.stalls[s],
                           "TP-cycles without issue, by cause (docs/statistics.md)", "TP-cycles");
@@ -641,24 +657,27 @@ void Chip::register_stats(stats::Registry& r) const {
         r.add_counter(p + "/local_store/loads", tm.counters.local_loads, "local-store loads");
         r.add_counter(p + "/local_store/stores", tm.counters.local_stores, "local-store stores");
     }
-    for (size_t g = 0; g < l2s_.size(); ++g) l2s_[g].register_stats(r, fmt::format("l2/{}", g));
+    for (size_t g = 0; g < l2s_.size(); ++g)
+        l2s_[g].register_stats(r, fmt::format("l2/{}", g));
     dram_.register_stats(r, "dram");
     global_registers_.register_stats(r, "global_registers");
 
     r.add_counter("chip/cycles", cycles_, "cycles until every thread exited and memory drained",
                   "cycles");
     const double clock_hz = config_.chip.clock_mhz * 1e6;
-    r.add_derived("chip/frame_seconds", [this, clock_hz] { return double(cycles_) / clock_hz; },
-                  "simulated time at chip.clock_mhz", "s");
-    r.add_derived("chip/fps", [this, clock_hz] { return cycles_ ? clock_hz / double(cycles_) : 0; },
-                  "frames per second if one run is one frame", "1/s");
+    r.add_derived(
+        "chip/frame_seconds", [this, clock_hz] { return double(cycles_) / clock_hz; },
+        "simulated time at chip.clock_mhz", "s");
+    r.add_derived(
+        "chip/fps", [this, clock_hz] { return cycles_ ? clock_hz / double(cycles_) : 0; },
+        "frames per second if one run is one frame", "1/s");
     r.add_sum("chip/instructions", "*/instructions", "instructions issued, all TMs");
-    r.add_derived("chip/issue_rate",
-                  [&r, threads, this] {
-                      return cycles_ ? r.value("chip/instructions") / (double(cycles_) * threads)
-                                     : 0.0;
-                  },
-                  "instructions per thread per cycle (1 = every TP issues every cycle)");
+    r.add_derived(
+        "chip/issue_rate",
+        [&r, threads, this] {
+            return cycles_ ? r.value("chip/instructions") / (double(cycles_) * threads) : 0.0;
+        },
+        "instructions per thread per cycle (1 = every TP issues every cycle)");
     r.add_sum("chip/active_tp_cycles", "*/active_tp_cycles", "TP-cycles before exit, all TMs",
               "TP-cycles");
     for (std::string_view stall : kStallNames)
@@ -680,35 +699,35 @@ void Chip::register_stats(stats::Registry& r) const {
         const std::string busy = fmt::format("chip/fu/{}/unit_busy_cycles", pool);
         r.add_sum(busy, fmt::format("*/fu/{}/unit_busy_cycles", pool),
                   "unit-cycles occupied, all TMs", "unit-cycles");
-        const double units =
-            double(pool_config(config_.fu, Pool(q)).count) * config_.chip.num_tms;
-        r.add_derived(fmt::format("chip/fu/{}/utilisation", pool),
-                      [&r, busy, units, this] {
-                          return cycles_ ? r.value(busy) / (units * double(cycles_)) : 0.0;
-                      },
-                      "busy unit-cycles / (units x cycles)");
+        const double units = double(pool_config(config_.fu, Pool(q)).count) * config_.chip.num_tms;
+        r.add_derived(
+            fmt::format("chip/fu/{}/utilisation", pool),
+            [&r, busy, units, this] {
+                return cycles_ ? r.value(busy) / (units * double(cycles_)) : 0.0;
+            },
+            "busy unit-cycles / (units x cycles)");
     }
     for (std::string_view level : {"l1", "l2"}) {
         const std::string from = level == "l1" ? "*/l1/" : "l2/*/";
-        for (std::string_view leaf : {"reads", "writes", "hits", "misses", "merged_misses",
-                                      "bank_conflicts", "mshr_full"})
+        for (std::string_view leaf :
+             {"reads", "writes", "hits", "misses", "merged_misses", "bank_conflicts", "mshr_full"})
             r.add_sum(fmt::format("chip/{}/{}", level, leaf), from + std::string(leaf),
                       fmt::format("{} {}, all caches", level, leaf), "accesses");
         r.add_ratio(fmt::format("chip/{}/hit_rate", level), fmt::format("chip/{}/hits", level),
                     fmt::format("chip/{}/reads", level), "hits / reads");
     }
-    r.add_derived("chip/dram/bandwidth_bytes_per_cycle",
-                  [&r, this] {
-                      return cycles_ ? (r.value("dram/bytes_read") + r.value("dram/bytes_written")) /
-                                           double(cycles_)
-                                     : 0.0;
-                  },
-                  "achieved DRAM bandwidth", "B/cycle");
-    r.add_derived("chip/dram/bandwidth_gbps",
-                  [&r, clock_hz] {
-                      return r.value("chip/dram/bandwidth_bytes_per_cycle") * clock_hz / 1e9;
-                  },
-                  "achieved DRAM bandwidth at chip.clock_mhz", "GB/s");
+    r.add_derived(
+        "chip/dram/bandwidth_bytes_per_cycle",
+        [&r, this] {
+            return cycles_ ? (r.value("dram/bytes_read") + r.value("dram/bytes_written")) /
+                                 double(cycles_)
+                           : 0.0;
+        },
+        "achieved DRAM bandwidth", "B/cycle");
+    r.add_derived(
+        "chip/dram/bandwidth_gbps",
+        [&r, clock_hz] { return r.value("chip/dram/bandwidth_bytes_per_cycle") * clock_hz / 1e9; },
+        "achieved DRAM bandwidth at chip.clock_mhz", "GB/s");
     r.add_counter("chip/local_store_high_water", local_store_high_water_,
                   "largest local-store (stack) footprint of any thread", "B");
 
@@ -720,8 +739,8 @@ void Chip::register_stats(stats::Registry& r) const {
             const std::string p = fmt::format("region/{}/{}/", name, level);
             r.add_counter(p + "reads", t.reads, cache ? "loads accepted" : "line reads served",
                           "accesses");
-            r.add_counter(p + "writes", t.writes,
-                          cache ? "stores accepted" : "line writes served", "accesses");
+            r.add_counter(p + "writes", t.writes, cache ? "stores accepted" : "line writes served",
+                          "accesses");
             if (cache) {
                 r.add_counter(p + "hits", t.hits, "loads that hit", "accesses");
                 r.add_counter(p + "misses", t.misses, "loads that requested a line below",

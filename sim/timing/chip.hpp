@@ -87,8 +87,7 @@ private:
     struct Tm;
     // The cycle loop is instantiated for the concrete MachineSource (its calls inline) and for
     // any other InstructionSource (tests' scripted sources); the constructor picks one.
-    template <class Source>
-    bool run_cycles(uint64_t end);
+    template <class Source> bool run_cycles(uint64_t end);
     bool busy() const;  // anything in flight except lines in write-combining buffers
     bool drained() const;
     /// Index of the region holding `addr` in layout_.regions, or other_region_.

@@ -19,8 +19,7 @@ struct Range {
 
 // The one list of configurable fields: key, storage and allowed range. Loading, overriding,
 // validation and printing all walk it, so a field cannot be forgotten by one of them.
-template <class Config, class Visit>
-void for_each_field(Config& c, Visit&& visit) {
+template <class Config, class Visit> void for_each_field(Config& c, Visit&& visit) {
     constexpr uint32_t kMaxLatency = 100000;
     visit("chip.clock_mhz", c.chip.clock_mhz, Range{1, 100000});
     visit("chip.num_tms", c.chip.num_tms, Range{1, 4096});
@@ -75,12 +74,10 @@ void for_each_field(Config& c, Visit&& visit) {
     visit("dram.tRTP", c.dram.tRTP, Range{1, 1000});
     visit("global_registers.latency", c.global_registers.latency, Range{1, kMaxLatency});
     visit("global_registers.per_cycle", c.global_registers.per_cycle, Range{1, 1024});
-    visit("global_registers.link_latency", c.global_registers.link_latency,
-          Range{1, kMaxLatency});
+    visit("global_registers.link_latency", c.global_registers.link_latency, Range{1, kMaxLatency});
 }
 
-template <class T>
-constexpr bool kIsBool = std::is_same_v<std::remove_cvref_t<T>, bool>;
+template <class T> constexpr bool kIsBool = std::is_same_v<std::remove_cvref_t<T>, bool>;
 
 std::string range_text(bool is_bool, Range r) {
     return is_bool ? "true or false" : fmt::format("{}..{}", r.min, r.max);
@@ -103,8 +100,8 @@ bool assign(ChipConfig& config, std::string_view key, std::optional<bool> as_boo
                 throw ConfigError(fmt::format("{}: {} must be an integer in {}", where, key,
                                               range_text(false, range)));
             if (*as_int < range.min || *as_int > range.max)
-                throw ConfigError(fmt::format("{}: {} = {} is out of range; allowed {}", where,
-                                              key, *as_int, range_text(false, range)));
+                throw ConfigError(fmt::format("{}: {} = {} is out of range; allowed {}", where, key,
+                                              *as_int, range_text(false, range)));
             field = static_cast<uint32_t>(*as_int);
         }
     });
@@ -122,19 +119,18 @@ bool assign(ChipConfig& config, std::string_view key, std::optional<bool> as_boo
         if (!section.empty() && name.starts_with(section))
             keys.emplace_back(name.substr(section.size()));
     });
-    throw ConfigError(
-        keys.empty()
-            ? fmt::format("{}: unknown key '{}'; the sections are {}", where, key,
-                          fmt::join(sections, ", "))
-            : fmt::format("{}: unknown key '{}'; valid keys in [{}] are {}", where, key,
-                          section.substr(0, section.size() - 1), fmt::join(keys, ", ")));
+    throw ConfigError(keys.empty() ? fmt::format("{}: unknown key '{}'; the sections are {}", where,
+                                                 key, fmt::join(sections, ", "))
+                                   : fmt::format("{}: unknown key '{}'; valid keys in [{}] are {}",
+                                                 where, key, section.substr(0, section.size() - 1),
+                                                 fmt::join(keys, ", ")));
 }
 
 void load_table(ChipConfig& config, const toml::table& table, const std::string& prefix,
                 std::string_view source_name) {
     for (const auto& [k, node] : table) {
-        const std::string key = prefix.empty() ? std::string(k.str())
-                                               : fmt::format("{}.{}", prefix, k.str());
+        const std::string key =
+            prefix.empty() ? std::string(k.str()) : fmt::format("{}.{}", prefix, k.str());
         const std::string where = fmt::format("{}:{}", source_name, node.source().begin.line);
         if (const toml::table* sub = node.as_table()) {
             load_table(config, *sub, key, source_name);
@@ -148,7 +144,9 @@ void load_table(ChipConfig& config, const toml::table& table, const std::string&
     }
 }
 
-bool is_pow2(uint32_t v) { return std::has_single_bit(v); }
+bool is_pow2(uint32_t v) {
+    return std::has_single_bit(v);
+}
 
 void check(bool ok, std::string_view message) {
     if (!ok) throw ConfigError(std::string(message));
@@ -198,8 +196,8 @@ ChipConfig parse_config(std::string_view toml_text, std::string_view source_name
     try {
         table = toml::parse(toml_text, source_name);
     } catch (const toml::parse_error& e) {
-        throw ConfigError(fmt::format("{}:{}: {}", source_name, e.source().begin.line,
-                                      e.description()));
+        throw ConfigError(
+            fmt::format("{}:{}: {}", source_name, e.source().begin.line, e.description()));
     }
     load_table(config, table, "", source_name);
     try {
@@ -233,8 +231,10 @@ void apply_override(ChipConfig& config, std::string_view assignment) {
     if (eq == std::string_view::npos)
         throw ConfigError(fmt::format("{}: expected key=value, e.g. l1.size_bytes=16384", where));
     auto trim = [](std::string_view s) {
-        while (!s.empty() && s.front() == ' ') s.remove_prefix(1);
-        while (!s.empty() && s.back() == ' ') s.remove_suffix(1);
+        while (!s.empty() && s.front() == ' ')
+            s.remove_prefix(1);
+        while (!s.empty() && s.back() == ' ')
+            s.remove_suffix(1);
         return s;
     };
     const std::string_view key = trim(assignment.substr(0, eq));

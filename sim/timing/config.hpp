@@ -46,15 +46,15 @@ struct FuConfig {
 /// [fu.*] The functional-unit pools of one TM (TRaX: ~1 FP add and 1 FP multiply per 8
 /// threads, 1 FP divide per TM, 1 integer multiply per 16 threads).
 struct FuPoolsConfig {
-    FuConfig int_alu{32, 1, true};      ///< add, logic, shifts, compares, lui/auipc, CSR, fence
-    FuConfig int_muldiv{2, 2, true};    ///< mul*, div*, rem*
-    FuConfig fp_add{4, 2, true};        ///< fadd, fsub
-    FuConfig fp_mul{4, 2, true};        ///< fmul and the fused multiply-add family
-    FuConfig fp_divsqrt{1, 16, true};   ///< fdiv, fsqrt
-    FuConfig fp_misc{8, 1, true};       ///< compare, min/max, sign injection, move, convert
-    FuConfig branch{8, 1, true};        ///< conditional branches and jumps
-    FuConfig load_store{8, 1, true};    ///< address generation; the cache adds its own latency
-    FuConfig atomic{1, 1, true};        ///< issue slot of global-register atomics
+    FuConfig int_alu{32, 1, true};     ///< add, logic, shifts, compares, lui/auipc, CSR, fence
+    FuConfig int_muldiv{2, 2, true};   ///< mul*, div*, rem*
+    FuConfig fp_add{4, 2, true};       ///< fadd, fsub
+    FuConfig fp_mul{4, 2, true};       ///< fmul and the fused multiply-add family
+    FuConfig fp_divsqrt{1, 16, true};  ///< fdiv, fsqrt
+    FuConfig fp_misc{8, 1, true};      ///< compare, min/max, sign injection, move, convert
+    FuConfig branch{8, 1, true};       ///< conditional branches and jumps
+    FuConfig load_store{8, 1, true};   ///< address generation; the cache adds its own latency
+    FuConfig atomic{1, 1, true};       ///< issue slot of global-register atomics
     bool operator==(const FuPoolsConfig&) const = default;
 };
 
@@ -90,28 +90,28 @@ struct L2Config : CacheConfig {
 /// [dram] Channels x banks with row buffers (open-page, FR-FCFS). All times are in core cycles
 /// (a GDDR part at 2x the core clock has half its own cycle counts).
 struct DramConfig {
-    uint32_t channels = 8;        ///< independent channels, each with its own data bus
-    uint32_t banks = 16;          ///< banks per channel, each with one row buffer
-    uint32_t row_bytes = 2048;    ///< bytes per row (page) of one bank
-    uint32_t queue_depth = 32;    ///< pending requests per channel before back-pressure
-    uint32_t tRCD = 12;           ///< activate to read/write, same bank
-    uint32_t tCL = 12;            ///< read command to first data
-    uint32_t tCWL = 4;            ///< write command to first data
-    uint32_t tRP = 12;            ///< precharge to activate, same bank
-    uint32_t tRAS = 28;           ///< activate to precharge, same bank
-    uint32_t tBURST = 2;          ///< data-bus cycles to move one cache line
-    uint32_t tCCD = 2;            ///< column command to column command, same channel
-    uint32_t tRRD = 5;            ///< activate to activate, different banks of a channel
-    uint32_t tWR = 12;            ///< end of write data to precharge (write recovery)
-    uint32_t tWTR = 5;            ///< end of write data to read command (turnaround)
-    uint32_t tRTP = 4;            ///< read command to precharge
+    uint32_t channels = 8;      ///< independent channels, each with its own data bus
+    uint32_t banks = 16;        ///< banks per channel, each with one row buffer
+    uint32_t row_bytes = 2048;  ///< bytes per row (page) of one bank
+    uint32_t queue_depth = 32;  ///< pending requests per channel before back-pressure
+    uint32_t tRCD = 12;         ///< activate to read/write, same bank
+    uint32_t tCL = 12;          ///< read command to first data
+    uint32_t tCWL = 4;          ///< write command to first data
+    uint32_t tRP = 12;          ///< precharge to activate, same bank
+    uint32_t tRAS = 28;         ///< activate to precharge, same bank
+    uint32_t tBURST = 2;        ///< data-bus cycles to move one cache line
+    uint32_t tCCD = 2;          ///< column command to column command, same channel
+    uint32_t tRRD = 5;          ///< activate to activate, different banks of a channel
+    uint32_t tWR = 12;          ///< end of write data to precharge (write recovery)
+    uint32_t tWTR = 5;          ///< end of write data to read command (turnaround)
+    uint32_t tRTP = 4;          ///< read command to precharge
     bool operator==(const DramConfig&) const = default;
 };
 
 /// [global_registers] The chip-wide unit serving atomic increments (work distribution).
 struct GlobalRegisterConfig {
-    uint32_t latency = 4;    ///< cycles from arrival at the unit to the reply
-    uint32_t per_cycle = 1;  ///< requests served per cycle, in (cycle, TM, sequence) order
+    uint32_t latency = 4;       ///< cycles from arrival at the unit to the reply
+    uint32_t per_cycle = 1;     ///< requests served per cycle, in (cycle, TM, sequence) order
     uint32_t link_latency = 2;  ///< cycles each way between a TM and the unit
     bool operator==(const GlobalRegisterConfig&) const = default;
 };

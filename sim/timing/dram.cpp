@@ -171,8 +171,8 @@ void Dram::register_stats(stats::Registry& r, std::string_view prefix) const {
                   "bytes of those line writes that stores wrote", "B");
     r.add_counter(name("row_hits"), counters_.row_hits, "requests served from an open row",
                   "requests");
-    r.add_counter(name("row_misses"), counters_.row_misses,
-                  "requests that activated a closed bank", "requests");
+    r.add_counter(name("row_misses"), counters_.row_misses, "requests that activated a closed bank",
+                  "requests");
     r.add_counter(name("row_conflicts"), counters_.row_conflicts,
                   "requests that closed another row first", "requests");
     r.add_counter(name("activates"), counters_.activates, "ACT commands", "commands");

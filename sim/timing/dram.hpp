@@ -49,8 +49,8 @@ public:
         uint64_t bytes_read = 0;
         uint64_t bytes_written = 0;
         uint64_t store_payload_bytes = 0;  ///< bytes the stores behind the line writes wrote
-        uint64_t row_hits = 0;       ///< served from an already open row
-        uint64_t row_misses = 0;     ///< needed an activate of a closed bank
+        uint64_t row_hits = 0;             ///< served from an already open row
+        uint64_t row_misses = 0;           ///< needed an activate of a closed bank
         uint64_t row_conflicts = 0;  ///< needed a precharge of another open row, then activate
         uint64_t activates = 0;
         uint64_t precharges = 0;

@@ -11,28 +11,38 @@ Pool pool_of(isa::FuClass fu) {
     using isa::FuClass;
     switch (fu) {
     case FuClass::IntAlu:
-    case FuClass::System: return Pool::IntAlu;
+    case FuClass::System:
+        return Pool::IntAlu;
     case FuClass::IntMul:
-    case FuClass::IntDiv: return Pool::IntMulDiv;
-    case FuClass::FpAdd: return Pool::FpAdd;
-    case FuClass::FpMul: return Pool::FpMul;
+    case FuClass::IntDiv:
+        return Pool::IntMulDiv;
+    case FuClass::FpAdd:
+        return Pool::FpAdd;
+    case FuClass::FpMul:
+        return Pool::FpMul;
     case FuClass::FpDiv:
-    case FuClass::FpSqrt: return Pool::FpDivSqrt;
-    case FuClass::FpMisc: return Pool::FpMisc;
-    case FuClass::Branch: return Pool::Branch;
+    case FuClass::FpSqrt:
+        return Pool::FpDivSqrt;
+    case FuClass::FpMisc:
+        return Pool::FpMisc;
+    case FuClass::Branch:
+        return Pool::Branch;
     case FuClass::Load:
-    case FuClass::Store: return Pool::LoadStore;
-    case FuClass::Atomic: return Pool::Atomic;
-    case FuClass::Count: break;
+    case FuClass::Store:
+        return Pool::LoadStore;
+    case FuClass::Atomic:
+        return Pool::Atomic;
+    case FuClass::Count:
+        break;
     }
-    throw std::invalid_argument(fmt::format("pool_of: FuClass {} has no pool",
-                                            static_cast<int>(fu)));
+    throw std::invalid_argument(
+        fmt::format("pool_of: FuClass {} has no pool", static_cast<int>(fu)));
 }
 
 std::string_view to_string(Pool pool) {
-    constexpr std::string_view kNames[] = {"int_alu", "int_muldiv", "fp_add",   "fp_mul",
-                                           "fp_divsqrt", "fp_misc", "branch", "load_store",
-                                           "atomic"};
+    constexpr std::string_view kNames[] = {"int_alu", "int_muldiv", "fp_add",
+                                           "fp_mul",  "fp_divsqrt", "fp_misc",
+                                           "branch",  "load_store", "atomic"};
     static_assert(std::size(kNames) == static_cast<size_t>(Pool::Count));
     return kNames[static_cast<size_t>(pool)];
 }

@@ -16,8 +16,18 @@
 namespace tpsim::timing {
 
 /// The pools of FuPoolsConfig; several isa::FuClass values share one pool.
-enum class Pool : uint8_t { IntAlu, IntMulDiv, FpAdd, FpMul, FpDivSqrt, FpMisc, Branch, LoadStore,
-                            Atomic, Count };
+enum class Pool : uint8_t {
+    IntAlu,
+    IntMulDiv,
+    FpAdd,
+    FpMul,
+    FpDivSqrt,
+    FpMisc,
+    Branch,
+    LoadStore,
+    Atomic,
+    Count
+};
 
 Pool pool_of(isa::FuClass fu);  // throws for FuClass::Count
 std::string_view to_string(Pool pool);
@@ -26,9 +36,9 @@ const FuConfig& pool_config(const FuPoolsConfig& pools, Pool pool);
 class FuPool {
 public:
     struct Counters {
-        uint64_t issued = 0;             ///< operations started
-        uint64_t denied = 0;             ///< requests refused because every unit was taken
-        uint64_t unit_busy_cycles = 0;   ///< unit-cycles occupied (issue slots if pipelined)
+        uint64_t issued = 0;            ///< operations started
+        uint64_t denied = 0;            ///< requests refused because every unit was taken
+        uint64_t unit_busy_cycles = 0;  ///< unit-cycles occupied (issue slots if pipelined)
     };
 
     FuPool(const FuConfig& config, uint32_t num_requesters);
@@ -63,7 +73,7 @@ public:
         const auto take = [&](const RotatedPart& part) __attribute__((always_inline)) {
             uint64_t won = part.of(requested_[part.w]);
             requested_[part.w] &= ~part.mask;  // taken: this part's requests are decided
-            if (denied != 0) {  // else every request wins
+            if (denied != 0) {                 // else every request wins
                 uint64_t first = 0;
                 for (uint64_t order = won; order != 0 && left != 0; order &= order - 1, --left)
                     first |= order & -order;
@@ -104,16 +114,17 @@ private:
             return config_.count - started_;
         }
         uint32_t free = 0;
-        for (uint64_t free_at : unit_free_at_) free += free_at <= now;
+        for (uint64_t free_at : unit_free_at_)
+            free += free_at <= now;
         return free;
     }
 
     FuConfig config_;
     uint32_t num_requesters_;
-    uint32_t next_priority_ = 0;          // requester that wins first next time
-    std::vector<uint64_t> requested_;     // bit per requester, this cycle
-    uint32_t requests_ = 0;               // bits set in requested_
-    std::vector<uint64_t> unit_free_at_;  // per unit, if not pipelined: first cycle it can start
+    uint32_t next_priority_ = 0;           // requester that wins first next time
+    std::vector<uint64_t> requested_;      // bit per requester, this cycle
+    uint32_t requests_ = 0;                // bits set in requested_
+    std::vector<uint64_t> unit_free_at_;   // per unit, if not pipelined: first cycle it can start
     uint64_t started_cycle_ = UINT64_MAX;  // if pipelined: operations started in started_cycle_
     uint32_t started_ = 0;
     Counters counters_;

@@ -16,7 +16,7 @@
 namespace tpsim::timing {
 
 struct AtomicRequest {
-    uint64_t sent = 0;      ///< cycle the TM sent it
+    uint64_t sent = 0;  ///< cycle the TM sent it
     uint32_t tm = 0;
     uint32_t sequence = 0;  ///< per-TM counter, breaks ties within a cycle
     uint32_t tp = 0;        ///< returned in the reply
@@ -31,8 +31,8 @@ struct AtomicReply {
 class GlobalRegisterUnit {
 public:
     struct Counters {
-        uint64_t requests = 0;      ///< atomic increments served
-        uint64_t queued_cycles = 0; ///< total cycles requests waited for a service slot
+        uint64_t requests = 0;       ///< atomic increments served
+        uint64_t queued_cycles = 0;  ///< total cycles requests waited for a service slot
     };
 
     explicit GlobalRegisterUnit(const GlobalRegisterConfig& config) : config_(config) {}

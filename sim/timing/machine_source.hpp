@@ -30,8 +30,7 @@ inline core::MachineConfig machine_config_for(const ChipConfig& chip) {
 /// up, for the functional engine, the cycle-level engine and their tests.
 inline std::unique_ptr<core::Machine> make_machine(const core::Program& program,
                                                    std::span<const uint32_t> global,
-                                                   uint64_t read_only_bytes,
-                                                   const ChipConfig& chip,
+                                                   uint64_t read_only_bytes, const ChipConfig& chip,
                                                    uint64_t max_instructions) {
     core::MachineConfig config = machine_config_for(chip);
     config.global_bytes = uint32_t(global.size_bytes());
@@ -53,7 +52,8 @@ class MachineSource final : public InstructionSource {
 public:
     explicit MachineSource(core::Machine& machine)
         : machine_(machine), ahead_(machine.thread_count()), next_pc_(machine.thread_count()) {
-        for (uint32_t t = 0; t < machine.thread_count(); ++t) next_pc_[t] = machine.next_pc(t);
+        for (uint32_t t = 0; t < machine.thread_count(); ++t)
+            next_pc_[t] = machine.next_pc(t);
     }
 
     core::Machine& machine() const { return machine_; }

@@ -29,21 +29,22 @@ uint32_t alu_imm(Op op, uint32_t a, int32_t imm) {
 
 constexpr uint32_t kIntMin = 0x8000'0000;
 
-} // namespace
+}  // namespace
 
 TEST_CASE("integer ALU and shifts", "[isa][execute]") {
-    CHECK(alu(Op::add, 0xffff'ffff, 1) == 0); // wraps
+    CHECK(alu(Op::add, 0xffff'ffff, 1) == 0);  // wraps
     CHECK(alu(Op::sub, 0, 1) == 0xffff'ffff);
-    CHECK(alu(Op::slt, kIntMin, 0) == 1);  // INT_MIN < 0 signed
-    CHECK(alu(Op::sltu, kIntMin, 0) == 0); // but not unsigned
-    CHECK(alu(Op::sll, 1, 33) == 2);       // shift amount is rs2[4:0]
+    CHECK(alu(Op::slt, kIntMin, 0) == 1);   // INT_MIN < 0 signed
+    CHECK(alu(Op::sltu, kIntMin, 0) == 0);  // but not unsigned
+    CHECK(alu(Op::sll, 1, 33) == 2);        // shift amount is rs2[4:0]
     CHECK(alu(Op::srl, kIntMin, 31) == 1);
     CHECK(alu(Op::sra, kIntMin, 31) == 0xffff'ffff);
     CHECK(alu(Op::xor_, 0xf0f0, 0xff00) == 0x0ff0);
     CHECK(alu(Op::or_, 0xf0f0, 0xff00) == 0xfff0);
     CHECK(alu(Op::and_, 0xf0f0, 0xff00) == 0xf000);
     CHECK(alu_imm(Op::addi, 5, -2048) == uint32_t(5 - 2048));
-    CHECK(alu_imm(Op::sltiu, 5, -1) == 1); // imm sign-extends to 0xffffffff, then compares unsigned
+    CHECK(alu_imm(Op::sltiu, 5, -1) ==
+          1);  // imm sign-extends to 0xffffffff, then compares unsigned
     CHECK(alu_imm(Op::slti, 5, -1) == 0);
     CHECK(alu_imm(Op::xori, 0x1234, -1) == ~0x1234u);
     CHECK(alu_imm(Op::srai, 0x8000'0000, 4) == 0xf800'0000);
@@ -69,7 +70,7 @@ TEST_CASE("M extension edge cases", "[isa][execute]") {
     CHECK(alu(Op::mulh, 0xffff'ffff, 0xffff'ffff) == 0);
     CHECK(alu(Op::mulhu, 0xffff'ffff, 0xffff'ffff) == 0xffff'fffe);
     CHECK(alu(Op::mulhsu, 0xffff'ffff, 0xffff'ffff) == 0xffff'ffff);
-    CHECK(alu(Op::mulh, kIntMin, kIntMin) == 0x4000'0000); // 2^62 >> 32
+    CHECK(alu(Op::mulh, kIntMin, kIntMin) == 0x4000'0000);  // 2^62 >> 32
 }
 
 TEST_CASE("x0 stays zero and pc/instret advance", "[isa][execute]") {
@@ -90,7 +91,7 @@ TEST_CASE("loads sign- or zero-extend, stores truncate", "[isa][execute]") {
     h.reg[1] = 0x100;
     h.reg[2] = 0x8180'ff80;
     run(h, env, encode(Op::sw, 0, x(1), x(2), 4));
-    CHECK(env.memory[0x104] == 0x80); // little-endian
+    CHECK(env.memory[0x104] == 0x80);  // little-endian
     run(h, env, encode(Op::lb, x(3), x(1), 0, 4));
     CHECK(h.reg[3] == 0xffff'ff80);
     run(h, env, encode(Op::lbu, x(3), x(1), 0, 4));
@@ -149,7 +150,7 @@ TEST_CASE("branches and jumps", "[isa][execute]") {
     run(h, env, encode(Op::lui, x(6), 0, 0, int32_t(0xabcde000)));
     CHECK(h.reg[6] == 0xabcd'e000);
     run(h, env, encode(Op::auipc, x(6), 0, 0, 0x1000));
-    CHECK(h.reg[6] == 0x2002 + 0x1000 + 4); // pc of the auipc: 0x2006
+    CHECK(h.reg[6] == 0x2002 + 0x1000 + 4);  // pc of the auipc: 0x2006
 }
 
 TEST_CASE("CSR instructions", "[isa][execute][csr]") {
@@ -189,16 +190,16 @@ TEST_CASE("system instructions", "[isa][execute]") {
     Hart h;
     FakeEnv env;
     h.pc = 0x40;
-    run(h, env, 0x0000'0073); // ecall
-    run(h, env, 0x0010'0073); // ebreak
-    run(h, env, 0);           // illegal
+    run(h, env, 0x0000'0073);  // ecall
+    run(h, env, 0x0010'0073);  // ebreak
+    run(h, env, 0);            // illegal
     CHECK(env.ecalls == 1);
     CHECK(env.ebreaks == 1);
     CHECK(env.illegals == 1);
     CHECK(h.pc == 0x40);
     CHECK(h.instret == 0);
-    run(h, env, 0x1050'0073); // wfi: no-op
-    run(h, env, 0x0ff0'000f); // fence iorw, iorw
+    run(h, env, 0x1050'0073);  // wfi: no-op
+    run(h, env, 0x0ff0'000f);  // fence iorw, iorw
     CHECK(h.pc == 0x48);
     // mret returns to mepc and sets MIE from MPIE.
     h.mepc = 0x200;
@@ -212,7 +213,7 @@ TEST_CASE("tp.atominc returns the old value and increments", "[isa][execute][cus
     Hart h;
     FakeEnv env;
     env.globals[3] = 41;
-    const uint32_t word = 3u << 20 | 10u << 7 | 0x0b; // tp.atominc a0, 3
+    const uint32_t word = 3u << 20 | 10u << 7 | 0x0b;  // tp.atominc a0, 3
     run(h, env, word);
     CHECK(h.reg[10] == 41);
     run(h, env, word);

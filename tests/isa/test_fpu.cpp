@@ -41,18 +41,18 @@ FpResult fp(Op op, uint32_t a, uint32_t b = 0, uint32_t rm = RNE, uint32_t c = 0
 }
 
 constexpr uint32_t kOne = 0x3f80'0000, kTwo = 0x4000'0000, kThree = 0x4040'0000;
-constexpr uint32_t kOneUlp = 0x3f80'0001;  // 1 + 2^-23
-constexpr uint32_t kTwoUlps = 0x3f80'0002; // 1 + 2^-22
-constexpr uint32_t kHalfUlp = 0x3380'0000; // 2^-24: half an ulp of 1.0
+constexpr uint32_t kOneUlp = 0x3f80'0001;   // 1 + 2^-23
+constexpr uint32_t kTwoUlps = 0x3f80'0002;  // 1 + 2^-22
+constexpr uint32_t kHalfUlp = 0x3380'0000;  // 2^-24: half an ulp of 1.0
 constexpr uint32_t kMinusOne = 0xbf80'0000, kMinusOneUlp = 0xbf80'0001;
 constexpr uint32_t kInf = 0x7f80'0000, kMinusInf = 0xff80'0000;
-constexpr uint32_t kMax = 0x7f7f'ffff;       // FLT_MAX
-constexpr uint32_t kMinNormal = 0x0080'0000; // 2^-126
-constexpr uint32_t kMinSub = 0x0000'0001;    // 2^-149
+constexpr uint32_t kMax = 0x7f7f'ffff;        // FLT_MAX
+constexpr uint32_t kMinNormal = 0x0080'0000;  // 2^-126
+constexpr uint32_t kMinSub = 0x0000'0001;     // 2^-149
 constexpr uint32_t kQNaN = 0x7fc0'0000, kSNaN = 0x7f80'0001, kPayloadQNaN = 0x7fc1'2345;
 constexpr uint32_t kPlusZero = 0, kMinusZero = 0x8000'0000;
 
-} // namespace
+}  // namespace
 
 TEST_CASE("fadd.s in every rounding mode", "[isa][fpu][rounding]") {
     // 1 + 2^-24 is exactly halfway between 1 and 1 + 2^-23: ties-even keeps 1 (even
@@ -103,7 +103,7 @@ TEST_CASE("exception flags", "[isa][fpu][flags]") {
     CHECK(fp(Op::fmul_s, kPlusZero, kInf) == FpResult{kCanonicalNaN, NV});
     CHECK(fp(Op::fsub_s, kInf, kInf) == FpResult{kCanonicalNaN, NV});
     CHECK(fp(Op::fsqrt_s, kMinusOne) == FpResult{kCanonicalNaN, NV});
-    CHECK(fp(Op::fsqrt_s, kMinusZero) == FpResult{kMinusZero, 0}); // sqrt(-0) = -0
+    CHECK(fp(Op::fsqrt_s, kMinusZero) == FpResult{kMinusZero, 0});  // sqrt(-0) = -0
     // Divide by zero: exact infinity, DZ only; 0/0 is invalid instead.
     CHECK(fp(Op::fdiv_s, kMinusOne, kPlusZero) == FpResult{kMinusInf, DZ});
     CHECK(fp(Op::fdiv_s, kPlusZero, kPlusZero) == FpResult{kCanonicalNaN, NV});
@@ -117,7 +117,7 @@ TEST_CASE("exception flags", "[isa][fpu][flags]") {
     // inf. 2^103 = 0x7300'0000.
     CHECK(fp(Op::fadd_s, kMax, 0x7300'0000, RMM) == FpResult{kInf, OF | NX});
     CHECK(fp(Op::fadd_s, kMax, 0x7300'0000, RNE) == FpResult{kInf, OF | NX});
-    CHECK(fp(Op::fadd_s, kMax, 0x7300'0000, RTZ) == FpResult{kMax, NX}); // RTZ: no overflow
+    CHECK(fp(Op::fadd_s, kMax, 0x7300'0000, RTZ) == FpResult{kMax, NX});  // RTZ: no overflow
     // Exact subnormal result: 2^-126 * 0.5 = 2^-127, no flags (underflow needs inexactness).
     CHECK(fp(Op::fmul_s, kMinNormal, 0x3f00'0000) == FpResult{0x0040'0000, 0});
     // 2^-149 * 0.5 = 2^-150 ties between 0 and 2^-149: RNE gives 0, RMM and RUP give 2^-149.
@@ -135,7 +135,7 @@ TEST_CASE("exception flags", "[isa][fpu][flags]") {
 
 TEST_CASE("NaN results are canonical", "[isa][fpu][nan]") {
     CHECK(fp(Op::fadd_s, kPayloadQNaN, kOne) == FpResult{kCanonicalNaN, 0});
-    CHECK(fp(Op::fmul_s, kOne, 0xffc0'0000) == FpResult{kCanonicalNaN, 0}); // negative qNaN in
+    CHECK(fp(Op::fmul_s, kOne, 0xffc0'0000) == FpResult{kCanonicalNaN, 0});  // negative qNaN in
     CHECK(fp(Op::fdiv_s, kSNaN, kOne) == FpResult{kCanonicalNaN, NV});
     CHECK(fp(Op::fadd_s, kSNaN, kOne, RMM) == FpResult{kCanonicalNaN, NV});
     CHECK(fp(Op::fnmadd_s, kPayloadQNaN, kOne, RNE, kOne) == FpResult{kCanonicalNaN, 0});
@@ -148,21 +148,21 @@ TEST_CASE("NaN results are canonical", "[isa][fpu][nan]") {
 }
 
 TEST_CASE("fmin.s and fmax.s", "[isa][fpu][minmax]") {
-    CHECK(fp(Op::fmin_s, kQNaN, kOne) == FpResult{kOne, 0}); // one NaN: the other operand
+    CHECK(fp(Op::fmin_s, kQNaN, kOne) == FpResult{kOne, 0});  // one NaN: the other operand
     CHECK(fp(Op::fmax_s, kTwo, kPayloadQNaN) == FpResult{kTwo, 0});
-    CHECK(fp(Op::fmin_s, kSNaN, kOne) == FpResult{kOne, NV}); // sNaN still signals
+    CHECK(fp(Op::fmin_s, kSNaN, kOne) == FpResult{kOne, NV});  // sNaN still signals
     CHECK(fp(Op::fmax_s, kSNaN, kPayloadQNaN) == FpResult{kCanonicalNaN, NV});
     CHECK(fp(Op::fmin_s, kPayloadQNaN, kPayloadQNaN) == FpResult{kCanonicalNaN, 0});
-    CHECK(fp(Op::fmin_s, kPlusZero, kMinusZero) == FpResult{kMinusZero, 0}); // -0 < +0
+    CHECK(fp(Op::fmin_s, kPlusZero, kMinusZero) == FpResult{kMinusZero, 0});  // -0 < +0
     CHECK(fp(Op::fmax_s, kMinusZero, kPlusZero) == FpResult{kPlusZero, 0});
     CHECK(fp(Op::fmin_s, kMinusOne, kMinusInf) == FpResult{kMinusInf, 0});
     CHECK(fp(Op::fmax_s, kMinusOne, kMinSub) == FpResult{kMinSub, 0});
 }
 
 TEST_CASE("comparisons", "[isa][fpu][compare]") {
-    CHECK(fp(Op::feq_s, kQNaN, kQNaN) == FpResult{0, 0}); // quiet: qNaN raises nothing
+    CHECK(fp(Op::feq_s, kQNaN, kQNaN) == FpResult{0, 0});  // quiet: qNaN raises nothing
     CHECK(fp(Op::feq_s, kSNaN, kOne) == FpResult{0, NV});
-    CHECK(fp(Op::flt_s, kQNaN, kOne) == FpResult{0, NV}); // signaling: any NaN raises NV
+    CHECK(fp(Op::flt_s, kQNaN, kOne) == FpResult{0, NV});  // signaling: any NaN raises NV
     CHECK(fp(Op::fle_s, kOne, kQNaN) == FpResult{0, NV});
     CHECK(fp(Op::feq_s, kMinusZero, kPlusZero) == FpResult{1, 0});
     CHECK(fp(Op::fle_s, kPlusZero, kMinusZero) == FpResult{1, 0});
@@ -174,30 +174,30 @@ TEST_CASE("comparisons", "[isa][fpu][compare]") {
 
 TEST_CASE("fcvt.w[u].s rounds, saturates and flags", "[isa][fpu][convert]") {
     constexpr uint32_t k2_5 = 0x4020'0000, kMinus2_5 = 0xc020'0000;
-    CHECK(fp(Op::fcvt_w_s, k2_5, 0, RNE) == FpResult{2, NX}); // tie to even
-    CHECK(fp(Op::fcvt_w_s, k2_5, 0, RMM) == FpResult{3, NX}); // tie away
+    CHECK(fp(Op::fcvt_w_s, k2_5, 0, RNE) == FpResult{2, NX});  // tie to even
+    CHECK(fp(Op::fcvt_w_s, k2_5, 0, RMM) == FpResult{3, NX});  // tie away
     CHECK(fp(Op::fcvt_w_s, kMinus2_5, 0, RNE) == FpResult{uint32_t(-2), NX});
     CHECK(fp(Op::fcvt_w_s, kMinus2_5, 0, RMM) == FpResult{uint32_t(-3), NX});
     CHECK(fp(Op::fcvt_w_s, kMinus2_5, 0, RTZ) == FpResult{uint32_t(-2), NX});
     CHECK(fp(Op::fcvt_w_s, kMinus2_5, 0, RDN) == FpResult{uint32_t(-3), NX});
     CHECK(fp(Op::fcvt_w_s, kMinus2_5, 0, RUP) == FpResult{uint32_t(-2), NX});
-    CHECK(fp(Op::fcvt_w_s, 0x3fc0'0000, 0, RNE) == FpResult{2, NX}); // 1.5 ties to even 2
+    CHECK(fp(Op::fcvt_w_s, 0x3fc0'0000, 0, RNE) == FpResult{2, NX});  // 1.5 ties to even 2
     CHECK(fp(Op::fcvt_w_s, kOne) == FpResult{1, 0});
-    CHECK(fp(Op::fcvt_w_s, 0xcf00'0000) == FpResult{0x8000'0000, 0}); // -2^31 is in range
+    CHECK(fp(Op::fcvt_w_s, 0xcf00'0000) == FpResult{0x8000'0000, 0});  // -2^31 is in range
     // Table 11.4: NaN and +inf -> 2^31 - 1, -inf -> -2^31, out-of-range -> the bound; NV only.
     CHECK(fp(Op::fcvt_w_s, kQNaN) == FpResult{0x7fff'ffff, NV});
     CHECK(fp(Op::fcvt_w_s, kInf) == FpResult{0x7fff'ffff, NV});
     CHECK(fp(Op::fcvt_w_s, kMinusInf) == FpResult{0x8000'0000, NV});
-    CHECK(fp(Op::fcvt_w_s, 0x4f00'0000) == FpResult{0x7fff'ffff, NV}); // 2^31
-    CHECK(fp(Op::fcvt_w_s, 0xcf00'0001) == FpResult{0x8000'0000, NV}); // just below -2^31
+    CHECK(fp(Op::fcvt_w_s, 0x4f00'0000) == FpResult{0x7fff'ffff, NV});  // 2^31
+    CHECK(fp(Op::fcvt_w_s, 0xcf00'0001) == FpResult{0x8000'0000, NV});  // just below -2^31
     CHECK(fp(Op::fcvt_wu_s, kQNaN) == FpResult{0xffff'ffff, NV});
     CHECK(fp(Op::fcvt_wu_s, kMinusOne) == FpResult{0, NV});
     CHECK(fp(Op::fcvt_wu_s, kMinusInf) == FpResult{0, NV});
-    CHECK(fp(Op::fcvt_wu_s, 0x4f80'0000) == FpResult{0xffff'ffff, NV}); // 2^32
+    CHECK(fp(Op::fcvt_wu_s, 0x4f80'0000) == FpResult{0xffff'ffff, NV});  // 2^32
     // -0.5 truncates to 0, which is representable: inexact, not invalid. RDN gives -1: invalid.
     CHECK(fp(Op::fcvt_wu_s, 0xbf00'0000, 0, RTZ) == FpResult{0, NX});
     CHECK(fp(Op::fcvt_wu_s, 0xbf00'0000, 0, RDN) == FpResult{0, NV});
-    CHECK(fp(Op::fcvt_wu_s, 0x4f6e'6b28) == FpResult{4'000'000'000u, 0}); // 4e9 is a float
+    CHECK(fp(Op::fcvt_wu_s, 0x4f6e'6b28) == FpResult{4'000'000'000u, 0});  // 4e9 is a float
 }
 
 TEST_CASE("fcvt.s.w[u] rounds", "[isa][fpu][convert]") {
@@ -224,14 +224,14 @@ TEST_CASE("fclass.s distinguishes all ten classes", "[isa][fpu][classify]") {
 TEST_CASE("fused multiply-add rounds once", "[isa][fpu][fma]") {
     // (1 + 2^-12)^2 - 1 = 2^-11 + 2^-24 exactly, representable as (1 + 2^-13) 2^-11. A separate
     // multiply would round the product's 2^-24 away (tie to even) and return 2^-11.
-    constexpr uint32_t a = 0x3f80'0800; // 1 + 2^-12
+    constexpr uint32_t a = 0x3f80'0800;  // 1 + 2^-12
     CHECK(fp(Op::fmadd_s, a, a, RNE, kMinusOne) == FpResult{0x3a00'0400, 0});
-    CHECK(fp(Op::fmul_s, a, a) == FpResult{0x3f80'1000, NX}); // the unfused product: 1 + 2^-11
+    CHECK(fp(Op::fmul_s, a, a) == FpResult{0x3f80'1000, NX});  // the unfused product: 1 + 2^-11
     // Sign conventions with a=2, b=3, c=1: fmsub 6-1, fnmsub -6+1, fnmadd -6-1.
-    CHECK(fp(Op::fmadd_s, kTwo, kThree, RNE, kOne) == FpResult{0x40e0'0000, 0});  // 7
-    CHECK(fp(Op::fmsub_s, kTwo, kThree, RNE, kOne) == FpResult{0x40a0'0000, 0});  // 5
-    CHECK(fp(Op::fnmsub_s, kTwo, kThree, RNE, kOne) == FpResult{0xc0a0'0000, 0}); // -5
-    CHECK(fp(Op::fnmadd_s, kTwo, kThree, RNE, kOne) == FpResult{0xc0e0'0000, 0}); // -7
+    CHECK(fp(Op::fmadd_s, kTwo, kThree, RNE, kOne) == FpResult{0x40e0'0000, 0});   // 7
+    CHECK(fp(Op::fmsub_s, kTwo, kThree, RNE, kOne) == FpResult{0x40a0'0000, 0});   // 5
+    CHECK(fp(Op::fnmsub_s, kTwo, kThree, RNE, kOne) == FpResult{0xc0a0'0000, 0});  // -5
+    CHECK(fp(Op::fnmadd_s, kTwo, kThree, RNE, kOne) == FpResult{0xc0e0'0000, 0});  // -7
     // inf * 0 + qNaN must raise NV (spec 11.6), result canonical.
     CHECK(fp(Op::fmadd_s, kInf, kPlusZero, RNE, kPayloadQNaN) == FpResult{kCanonicalNaN, NV});
     // RMM on a fused tie: 1 * 1 + 2^-24 ties; away from zero gives 1 + 2^-23, RNE keeps 1.
@@ -242,7 +242,7 @@ TEST_CASE("fused multiply-add rounds once", "[isa][fpu][fma]") {
 TEST_CASE("directed FP ops leave the host in round-to-nearest", "[isa][fpu]") {
     fp(Op::fadd_s, kOne, kHalfUlp, RUP);
     volatile float one = 1.0f, half_ulp = 0x1p-24f;
-    CHECK(one + half_ulp == 1.0f); // would be 1 + 2^-23 if RUP leaked
+    CHECK(one + half_ulp == 1.0f);  // would be 1 + 2^-23 if RUP leaked
 }
 
 TEST_CASE("integer instructions do not touch fflags", "[isa][fpu]") {
@@ -250,7 +250,7 @@ TEST_CASE("integer instructions do not touch fflags", "[isa][fpu]") {
     FakeEnv env;
     h.fflags = NX;
     h.reg[1] = 1;
-    run(h, env, encode(Op::div, x(3), x(1), x(0))); // divide by zero: no FP flag
+    run(h, env, encode(Op::div, x(3), x(1), x(0)));  // divide by zero: no FP flag
     CHECK(h.fflags == NX);
 }
 
@@ -264,7 +264,7 @@ double next_down(float value) {
     return std::nextafter(value, -std::numeric_limits<float>::infinity());
 }
 
-} // namespace
+}  // namespace
 
 TEST_CASE("fmul.s rounds correctly in every mode on random operands", "[isa][fpu][rounding]") {
     // A float product is exact in double (48 significant bits), so each mode's defining property
@@ -302,7 +302,7 @@ namespace {
 
 /// Operands for the fast-path equivalence test below.
 class Operands {
-  public:
+public:
     explicit Operands(uint32_t seed) : rng_(seed) {}
     int pick(int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng_); }
     uint32_t uniform() { return uint32_t(rng_()); }
@@ -325,7 +325,7 @@ class Operands {
         return (uniform() & kSignBit) | kSpecials[pick(0, std::size(kSpecials) - 1)];
     }
 
-  private:
+private:
     std::mt19937 rng_;
 };
 
@@ -347,7 +347,7 @@ using Aim = std::array<int, 3> (*)(Operands&, int e);
 std::array<int, 3> sum_near(Operands& g, int e) {
     return {e + g.pick(-2, 2), e + g.pick(-2, 2), 0};
 }
-std::array<int, 3> product_near(Operands& g, int e) { // the third exponent is fma's addend
+std::array<int, 3> product_near(Operands& g, int e) {  // the third exponent is fma's addend
     const int ea = g.pick(std::max(0, e - 127), std::min(254, e + 127));
     return {ea, e - ea + 127 + g.pick(-2, 2), e + g.pick(-2, 2)};
 }
@@ -376,7 +376,7 @@ const FastPathOp kFastPathOps[] = {
     {"fma", ternary<fpu::fma>, ternary<reference::fma>, product_near, NX | UF | OF | NV},
 };
 
-} // namespace
+}  // namespace
 
 TEST_CASE("the RNE fast paths agree with the MXCSR path on result and flags",
           "[isa][fpu][rounding]") {
@@ -392,13 +392,13 @@ TEST_CASE("the RNE fast paths agree with the MXCSR path on result and flags",
         for (int trial = 0; trial < 200'000; ++trial) {
             std::array<uint32_t, 3> in{};
             const int kind = g.pick(0, 5);
-            if (kind == 0 || kind == 5) { // uniform bit patterns; specials mixed into them
+            if (kind == 0 || kind == 5) {  // uniform bit patterns; specials mixed into them
                 for (uint32_t& v : in)
                     v = kind == 5 && g.pick(0, 1) ? g.special() : g.uniform();
             } else if (kind == 4) {
                 for (uint32_t& v : in)
                     v = g.simple();
-            } else { // results anywhere (close exponents), near 2^-126 or near FLT_MAX
+            } else {  // results anywhere (close exponents), near 2^-126 or near FLT_MAX
                 const int target = kind == 1   ? g.pick(1, 254)
                                    : kind == 2 ? g.pick(0, 3)
                                                : g.pick(252, 254);
@@ -417,6 +417,6 @@ TEST_CASE("the RNE fast paths agree with the MXCSR path on result and flags",
         }
         INFO(op.name);
         CHECK(flags_seen == op.flags_expected);
-        CHECK(exact_normal > 5'000); // exact results are common enough to test "no NX"
+        CHECK(exact_normal > 5'000);  // exact results are common enough to test "no NX"
     }
 }

@@ -95,7 +95,7 @@ struct FakeEnv {
     void ebreak(Hart&) { ++ebreaks; }
     void illegal(Hart&, const Decoded&) { ++illegals; }
 
-  private:
+private:
     void check(uint32_t addr, size_t size) const {
         if (addr + size > memory.size())
             throw std::out_of_range("fake memory: address out of range");
@@ -111,4 +111,4 @@ inline uint32_t bits(float value) {
     return std::bit_cast<uint32_t>(value);
 }
 
-} // namespace tpsim::isa::test
+}  // namespace tpsim::isa::test

@@ -28,7 +28,7 @@ TEST_CASE("every table entry is self-consistent", "[isa][table]") {
         const InsnInfo& insn = info(Op(i));
         INFO(insn.mnemonic);
         CHECK((insn.match & ~insn.mask) == 0);
-        CHECK((insn.mask & 0x7f) == 0x7f); // the major opcode is always fixed
+        CHECK((insn.mask & 0x7f) == 0x7f);  // the major opcode is always fixed
         CHECK(insn.fu != FuClass::Count);
     }
 }
@@ -44,7 +44,7 @@ TEST_CASE("every instruction decodes back to itself from random operand fields",
             const Decoded d = decode(word);
             const uint32_t rm = word >> 12 & 7;
             if (insn.operands.rounding_mode && (rm == 5 || rm == 6)) {
-                CHECK(d.op == Op::Illegal); // reserved rounding modes
+                CHECK(d.op == Op::Illegal);  // reserved rounding modes
                 continue;
             }
             REQUIRE(d.op == op);
@@ -64,17 +64,17 @@ TEST_CASE("every instruction decodes back to itself from random operand fields",
 }
 
 TEST_CASE("decoder rejects what is not RV32IMF + tpsim", "[isa][decode]") {
-    CHECK(decode(0x0000'0000).op == Op::Illegal); // all-zero word: defined illegal
+    CHECK(decode(0x0000'0000).op == Op::Illegal);  // all-zero word: defined illegal
     CHECK(decode(0x0000'0000).fu == info(Op::Illegal).fu);
-    CHECK(decode(0xffff'ffff).op == Op::Illegal); // all-ones word: defined illegal
-    CHECK(decode(0x0200'1013).op == Op::Illegal); // slli with shamt[5]=1 is RV64 only
-    CHECK(decode(0x0000'3003).op == Op::Illegal); // ld (RV64)
-    CHECK(decode(0x0000'3007).op == Op::Illegal); // fld (D extension)
-    CHECK(decode(0x0200'0053).op == Op::Illegal); // fadd.d
-    CHECK(decode(0x1000'202f).op == Op::Illegal); // lr.w (A extension)
-    CHECK(decode(0x0000'0001).op == Op::Illegal); // compressed quadrant
-    CHECK(decode(0x0000'800b).op == Op::Illegal); // custom-0 with rs1 = x1
-    CHECK(decode(0x1000'000b).op == Op::Illegal); // custom-0 with imm = 256
+    CHECK(decode(0xffff'ffff).op == Op::Illegal);  // all-ones word: defined illegal
+    CHECK(decode(0x0200'1013).op == Op::Illegal);  // slli with shamt[5]=1 is RV64 only
+    CHECK(decode(0x0000'3003).op == Op::Illegal);  // ld (RV64)
+    CHECK(decode(0x0000'3007).op == Op::Illegal);  // fld (D extension)
+    CHECK(decode(0x0200'0053).op == Op::Illegal);  // fadd.d
+    CHECK(decode(0x1000'202f).op == Op::Illegal);  // lr.w (A extension)
+    CHECK(decode(0x0000'0001).op == Op::Illegal);  // compressed quadrant
+    CHECK(decode(0x0000'800b).op == Op::Illegal);  // custom-0 with rs1 = x1
+    CHECK(decode(0x1000'000b).op == Op::Illegal);  // custom-0 with imm = 256
     // fadd.s with rm = 5 and 6 is reserved; 7 (dynamic) is legal.
     CHECK(decode(encode(Op::fadd_s, 1, 2, 3, 0, 5)).op == Op::Illegal);
     CHECK(decode(encode(Op::fadd_s, 1, 2, 3, 0, 6)).op == Op::Illegal);
@@ -119,7 +119,7 @@ std::string collapse_whitespace(const std::string& s) {
     return out;
 }
 
-} // namespace
+}  // namespace
 
 TEST_CASE("decode and disassembly match LLVM on every instruction", "[isa][decode][disasm][llvm]") {
     // Source mnemonics, in order, one instruction per non-comment line.

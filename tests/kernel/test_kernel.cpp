@@ -55,8 +55,7 @@ struct Image {
         std::memcpy(words.data(), &header, sizeof header);
     }
     void sync_header() { std::memcpy(words.data(), &header, sizeof header); }
-    template <class Record>
-    void put(const layout::SectionRef& s, int index, const Record& r) {
+    template <class Record> void put(const layout::SectionRef& s, int index, const Record& r) {
         std::memcpy(&words[s.addr + index * sizeof(Record) / 4], &r, sizeof r);
     }
     float fb(int pixel, int channel) const {
@@ -85,7 +84,11 @@ struct Twin {
         char error[512] = "";
         const TraxNativeContext ctx{image.words.data(),
                                     word_count ? word_count : uint32_t(image.words.size()),
-                                    threads, tms, tm_size, error, sizeof error};
+                                    threads,
+                                    tms,
+                                    tm_size,
+                                    error,
+                                    sizeof error};
         const int status = run(&ctx);
         CHECK((status == 0) == (error[0] == '\0'));
         return error;
@@ -145,7 +148,8 @@ struct ElfFile {
 
 }  // namespace
 
-TEST_CASE("kernel: kernel ELFs are RV32 executables with only the expected sections and no undefined symbols") {
+TEST_CASE("kernel: kernel ELFs are RV32 executables with only the expected sections and no "
+          "undefined symbols") {
     const auto name = GENERATE(as<std::string>{}, "hello", "primary_brute");
     INFO("kernel " << name);
     ElfFile f(kKernels + "/" + name + ".elf");
@@ -170,8 +174,8 @@ TEST_CASE("kernel: kernel ELFs are RV32 executables with only the expected secti
 
     size_t shstrndx = 0;
     REQUIRE(elf_getshdrstrndx(f.elf, &shstrndx) == 0);
-    const std::set<std::string> allowed = {".text", ".rodata", ".data", ".bss", ".symtab",
-                                           ".strtab", ".shstrtab", ".riscv.attributes"};
+    const std::set<std::string> allowed = {".text",   ".rodata", ".data",     ".bss",
+                                           ".symtab", ".strtab", ".shstrtab", ".riscv.attributes"};
     bool has_text = false;
     for (Elf_Scn* scn = elf_nextscn(f.elf, nullptr); scn; scn = elf_nextscn(f.elf, scn)) {
         GElf_Shdr sh;
@@ -245,8 +249,9 @@ Image lit_triangle_scene(uint32_t flags, bool with_occluder) {
               layout::Triangle{{-4, -4, -2}, {4, -4, -2}, {0, 4, -2}, 0});
     // Halfway between pixel (1,1)'s hit point (-0.5, 0.5, -2) and the light, off its camera ray.
     if (with_occluder)
-        image.put(image.header.triangles, 1,
-                  layout::Triangle{{0.5f, 0.25f, -1.5f}, {1, 0.25f, -1.5f}, {0.75f, 0.9f, -1.5f}, 0});
+        image.put(
+            image.header.triangles, 1,
+            layout::Triangle{{0.5f, 0.25f, -1.5f}, {1, 0.25f, -1.5f}, {0.75f, 0.9f, -1.5f}, 0});
     return image;
 }
 

@@ -42,7 +42,8 @@ TEST_CASE("render: the simulated Cornell box equals the native twin bit for bit"
     CHECK(diff == -1);
     // Not a blank image: the lit scene has many distinct values.
     size_t lit = 0;
-    for (float v : simulated.rgb) lit += v > 0.05f;
+    for (float v : simulated.rgb)
+        lit += v > 0.05f;
     CHECK(lit > simulated.rgb.size() / 2);
 }
 
@@ -87,8 +88,8 @@ TEST_CASE("render: the BVH tracer renders the Cornell box like its twin and like
     CHECK(traced.traversal.stack_overflows == 0);
     CHECK(traced.traversal.max_stack_depth <= traced.bvh->max_depth);
 
-    render::RenderOptions brute = small_options("cornell.toml", "primary_brute.elf",
-                                                render::Engine::native);
+    render::RenderOptions brute =
+        small_options("cornell.toml", "primary_brute.elf", render::Engine::native);
     brute.image_width = brute.image_height = 64;
     const render::RenderResult reference = render::render(brute);
     CHECK_FALSE(reference.bvh.has_value());  // ... the brute-force kernel's does not

@@ -62,11 +62,12 @@ Mesh icosphere(int levels) {
     std::vector<glm::vec3> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
                                 {0, -1, t}, {0, 1, t}, {0, -1, -t}, {0, 1, -t},
                                 {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-    for (glm::vec3& p : v) p = glm::normalize(p);
+    for (glm::vec3& p : v)
+        p = glm::normalize(p);
     std::vector<std::array<uint32_t, 3>> faces = {
-        {0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+        {0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
         {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-        {3, 8, 9},  {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+        {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
     for (int level = 0; level < levels; ++level) {
         std::map<std::pair<uint32_t, uint32_t>, uint32_t> midpoints;
         const auto midpoint = [&](uint32_t a, uint32_t b) {
@@ -90,19 +91,22 @@ Mesh icosphere(int levels) {
         faces = std::move(finer);
     }
     Mesh mesh;
-    for (const auto& f : faces) mesh.push_back({v[f[0]], v[f[1]], v[f[2]]});
+    for (const auto& f : faces)
+        mesh.push_back({v[f[0]], v[f[1]], v[f[2]]});
     return mesh;
 }
 
 Mesh transformed(Mesh mesh, float scale, glm::vec3 offset) {
     for (scene::Triangle& t : mesh)
-        for (glm::vec3* p : {&t.v0, &t.v1, &t.v2}) *p = *p * scale + offset;
+        for (glm::vec3* p : {&t.v0, &t.v1, &t.v2})
+            *p = *p * scale + offset;
     return mesh;
 }
 
 Ray make_ray(glm::vec3 origin, glm::vec3 dir, float t_max, int mode = trax::layout::kRayClosestHit,
              int surface_triangle = -1) {
-    return Ray{{origin.x, origin.y, origin.z}, {dir.x, dir.y, dir.z}, t_max, mode, surface_triangle};
+    return Ray{
+        {origin.x, origin.y, origin.z}, {dir.x, dir.y, dir.z}, t_max, mode, surface_triangle};
 }
 
 struct Queries {
@@ -128,7 +132,8 @@ Queries run_queries(const Mesh& mesh, const std::vector<Ray>& rays) {
     timing::ChipConfig chip;
     chip.chip.num_tms = 1;
     chip.chip.tps_per_tm = 4;
-    const auto kernel = render::Kernel::load(std::filesystem::path(TPSIM_KERNEL_DIR) / "ray_query.elf");
+    const auto kernel =
+        render::Kernel::load(std::filesystem::path(TPSIM_KERNEL_DIR) / "ray_query.elf");
     // A finite instruction budget: a ray that hung the traversal would fail the run.
     const uint64_t budget = 20000 * uint64_t(rays.size()) + 100000;
 
@@ -138,7 +143,8 @@ Queries run_queries(const Mesh& mesh, const std::vector<Ray>& rays) {
         image::MemoryImage img = image::build_memory_image(s, &q.bvh, 4, rays);
         render::run_kernel(kernel, engines[e], img, chip, budget);
         per_engine[e] = image::read_ray_results(img.header, img.words.data());
-        const image::TraversalTotals totals = image::read_thread_stats(img.header, img.words.data());
+        const image::TraversalTotals totals =
+            image::read_thread_stats(img.header, img.words.data());
         CHECK(totals.rays() == rays.size());
         CHECK(totals.stack_overflows == 0);
     }
@@ -187,7 +193,8 @@ void check_no_leaks(const Mesh& mesh, glm::vec3 inside) {
         const RayResult& r = q.results[i];
         if (r.triangle < 0 || !std::isfinite(r.t)) ++leaks;
         // Closest hit of a ray aimed at a surface point of a convex or star-shaped mesh.
-        else if (i % 2 == 0 && std::abs(r.t - 1.0f) > 1e-4f) ++closest_off;
+        else if (i % 2 == 0 && std::abs(r.t - 1.0f) > 1e-4f)
+            ++closest_off;
     }
     INFO(targets.size() << " targets, " << leaks << " leaks, " << closest_off
                         << " closest hits not at the target");
@@ -212,7 +219,8 @@ TEST_CASE("robustness: rays at every vertex and edge of closed meshes never leak
     for (const Placement& p : placements) {
         SECTION(std::string("grid cube, ") + p.name) {
             // The centre, and an off-centre point: different directions hit different edges.
-            check_no_leaks(transformed(cube, p.scale, p.offset), glm::vec3(0.5f) * p.scale + p.offset);
+            check_no_leaks(transformed(cube, p.scale, p.offset),
+                           glm::vec3(0.5f) * p.scale + p.offset);
             check_no_leaks(transformed(cube, p.scale, p.offset),
                            glm::vec3(0.3f, 0.55f, 0.7f) * p.scale + p.offset);
         }
@@ -289,8 +297,8 @@ TEST_CASE("robustness: degenerate and zero-area triangles are never hit and give
     mesh.push_back({c, c, c});  // a point
     mesh.push_back({a, b, a});
     std::vector<Ray> rays;
-    const glm::vec3 origins[] = {{2.5f, 2.0f, 0.5f}, {2.5f, 0.5f, -1.0f}, {1.5f, 0.5f, 0.5f},
-                                 {2.2f, 0.5f, 0.5f}};
+    const glm::vec3 origins[] = {
+        {2.5f, 2.0f, 0.5f}, {2.5f, 0.5f, -1.0f}, {1.5f, 0.5f, 0.5f}, {2.2f, 0.5f, 0.5f}};
     for (const glm::vec3& o : origins)
         for (const glm::vec3& target : {a, b, c, (a + b) * 0.5f}) {
             if (o == target) continue;
@@ -346,14 +354,15 @@ TEST_CASE("robustness: rays leaving a surface never hit their own triangle", "[r
     const float scales[] = {1.0f, 1e-4f, 1e4f, 100.0f};
     const glm::vec3 offsets[] = {glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f),
                                  glm::vec3(1e5f, 1e5f, -1e5f)};
-    const glm::vec3 weights[] = {{1 / 3.f, 1 / 3.f, 1 / 3.f}, {0.98f, 0.01f, 0.01f},
-                                 {0.5f, 0.5f, 0.0f}, {1.0f, 0.0f, 0.0f}};
+    const glm::vec3 weights[] = {
+        {1 / 3.f, 1 / 3.f, 1 / 3.f}, {0.98f, 0.01f, 0.01f}, {0.5f, 0.5f, 0.0f}, {1.0f, 0.0f, 0.0f}};
     for (int k = 0; k < 4; ++k) {
         // Shared vertices and edges included: a vertex (weight 1) lies on several triangles.
         const Mesh mesh = transformed(icosphere(1), scales[k], offsets[k]);
         const scene::Bvh bvh = bvh_for(mesh);
         std::vector<int32_t> image_index(mesh.size());
-        for (size_t i = 0; i < bvh.triangle_order.size(); ++i) image_index[bvh.triangle_order[i]] = int32_t(i);
+        for (size_t i = 0; i < bvh.triangle_order.size(); ++i)
+            image_index[bvh.triangle_order[i]] = int32_t(i);
         std::vector<Ray> rays;
         std::vector<uint32_t> source;
         for (uint32_t t = 0; t < mesh.size(); ++t) {
@@ -366,7 +375,8 @@ TEST_CASE("robustness: rays leaving a surface never hit their own triangle", "[r
                 for (const glm::vec3& dir :
                      {n * scales[k], (n * 0.05f + tangent) * scales[k], -n * scales[k]}) {
                     const int mode = trax::layout::kRayFromSurface;
-                    rays.push_back(make_ray(p, dir, 1.0f, mode | trax::layout::kRayAnyHit, image_index[t]));
+                    rays.push_back(
+                        make_ray(p, dir, 1.0f, mode | trax::layout::kRayAnyHit, image_index[t]));
                     rays.push_back(make_ray(p, dir * 4.0f, kInf, mode, image_index[t]));
                     source.insert(source.end(), 2, t);
                 }
@@ -397,7 +407,7 @@ TEST_CASE("robustness: a hit point on a large floor at y = 0 does not shadow its
     // above or below 0. The paper's absolute "near the origin" step (1/65536 = 1.5e-5) cannot
     // lift a point 1e-4 below the floor; the scale-free offset must.
     const glm::vec3 a(0.0f, 0.0f, 0.0f), b(556.0f, 0.0f, 0.0f), c(556.0f, 0.0f, 559.0f),
-                    d(0.0f, 0.0f, 559.0f);
+        d(0.0f, 0.0f, 559.0f);
     const Mesh floor = {{a, b, c}, {a, c, d}};
     const scene::Bvh bvh = bvh_for(floor);
     const glm::vec3 light(278.0f, 548.0f, 279.5f);
@@ -415,7 +425,8 @@ TEST_CASE("robustness: a hit point on a large floor at y = 0 does not shadow its
             }
     const Queries q = run_queries(floor, rays);
     size_t shadowed = 0;
-    for (const RayResult& r : q.results) shadowed += r.triangle >= 0;
+    for (const RayResult& r : q.results)
+        shadowed += r.triangle >= 0;
     INFO(shadowed << " of " << rays.size() << " floor points shadowed by the floor");
     CHECK(shadowed == 0);
 }

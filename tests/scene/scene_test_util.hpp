@@ -10,7 +10,8 @@ namespace tpsim::scene::testing {
 
 /// A per-process scratch directory, so parallel ctest runs do not collide.
 inline std::filesystem::path scratch_dir() {
-    const auto dir = std::filesystem::temp_directory_path() / ("tpsim_scene_test_" + std::to_string(getpid()));
+    const auto dir =
+        std::filesystem::temp_directory_path() / ("tpsim_scene_test_" + std::to_string(getpid()));
     std::filesystem::create_directories(dir);
     return dir;
 }

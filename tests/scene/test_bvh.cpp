@@ -14,7 +14,8 @@ using namespace tpsim::scene;
 namespace {
 
 /// Checks every structural promise build_bvh makes, independently of how it was built.
-void check_invariants(const Bvh& bvh, const std::vector<Triangle>& triangles, const BvhConfig& config) {
+void check_invariants(const Bvh& bvh, const std::vector<Triangle>& triangles,
+                      const BvhConfig& config) {
     const uint32_t n = uint32_t(triangles.size());
     REQUIRE(bvh.triangle_order.size() == n);
     REQUIRE(!bvh.nodes.empty());
@@ -39,7 +40,8 @@ void check_invariants(const Bvh& bvh, const std::vector<Triangle>& triangles, co
             max_depth = std::max(max_depth, depth);
             REQUIRE(node.triangle_count <= config.max_leaf_size);
             REQUIRE(uint64_t(node.first_triangle) + node.triangle_count <= n);
-            for (uint32_t i = node.first_triangle; i < node.first_triangle + node.triangle_count; ++i) {
+            for (uint32_t i = node.first_triangle; i < node.first_triangle + node.triangle_count;
+                 ++i) {
                 ++covered[i];
                 const uint32_t t = bvh.triangle_order[i];
                 REQUIRE(t < n);
@@ -65,7 +67,8 @@ void check_invariants(const Bvh& bvh, const std::vector<Triangle>& triangles, co
     CHECK(bvh.stats.leaves == leaves);
     CHECK(bvh.stats.nodes == 2 * leaves - 1);  // a full binary tree
     uint32_t histogram_leaves = 0;
-    for (uint32_t c : bvh.stats.leaf_size_histogram) histogram_leaves += c;
+    for (uint32_t c : bvh.stats.leaf_size_histogram)
+        histogram_leaves += c;
     CHECK(histogram_leaves == leaves);
     CHECK(std::isfinite(bvh.stats.sah_cost));
 }
@@ -91,7 +94,8 @@ std::vector<Triangle> geometric_strip(uint32_t count) {
     const double ratio = 1.00002;
     for (uint32_t i = 0; i < count; ++i) {
         const double next = x * ratio;
-        triangles.push_back({{float(x), 0.f, 0.f}, {float(next), 0.f, 0.f}, {float(x), float(next - x), 0.f}, 0});
+        triangles.push_back(
+            {{float(x), 0.f, 0.f}, {float(next), 0.f, 0.f}, {float(x), float(next - x), 0.f}, 0});
         x = next;
     }
     return triangles;
@@ -104,7 +108,8 @@ const BvhBuilder kBuilders[] = {BvhBuilder::sweep, BvhBuilder::binned};
 TEST_CASE("A hand-computed two-triangle tree has the expected SAH cost", "[bvh]") {
     // Each triangle's box is a unit cube (area 6); together they span [0,10]x[0,1]x[0,1] (area 42).
     // Leaf: 2 * 42 = 84; split: 42 + 6 + 6 = 54 -> split, cost (42 + 6 + 6) / 42.
-    const std::vector<Triangle> triangles{{{0, 0, 0}, {1, 1, 0}, {1, 0, 1}, 0}, {{9, 0, 0}, {10, 1, 0}, {10, 0, 1}, 0}};
+    const std::vector<Triangle> triangles{{{0, 0, 0}, {1, 1, 0}, {1, 0, 1}, 0},
+                                          {{9, 0, 0}, {10, 1, 0}, {10, 0, 1}, 0}};
     for (BvhBuilder builder : kBuilders) {
         const Bvh bvh = build_bvh(triangles, {.builder = builder});
         CHECK(bvh.stats.nodes == 3);
@@ -188,7 +193,8 @@ TEST_CASE("Identical and degenerate triangles build valid trees", "[bvh]") {
     std::vector<Triangle> triangles(1000, Triangle{{1, 2, 3}, {4, 5, 6}, {7, 8, 10}, 0});
     std::vector<Triangle> points(300, Triangle{{1, 1, 1}, {1, 1, 1}, {1, 1, 1}, 0});
     std::vector<Triangle> lines;
-    for (int i = 0; i < 300; ++i) lines.push_back({{float(i), 0, 0}, {float(i + 1), 0, 0}, {float(i), 0, 0}, 0});
+    for (int i = 0; i < 300; ++i)
+        lines.push_back({{float(i), 0, 0}, {float(i + 1), 0, 0}, {float(i), 0, 0}, 0});
     for (const auto* soup : {&triangles, &points, &lines})
         for (BvhBuilder builder : kBuilders) {
             const BvhConfig config{.builder = builder};
@@ -207,14 +213,16 @@ TEST_CASE("The SAH cost does not depend on scale or position", "[bvh]") {
             INFO("scale " << scale << " shift " << shift);
             std::vector<Triangle> moved = sphere;
             for (Triangle& t : moved)
-                for (glm::vec3* v : {&t.v0, &t.v1, &t.v2}) *v = *v * scale + glm::vec3(shift);
+                for (glm::vec3* v : {&t.v0, &t.v1, &t.v2})
+                    *v = *v * scale + glm::vec3(shift);
             for (BvhBuilder builder : kBuilders) {
                 const BvhConfig config{.builder = builder};
                 const Bvh bvh = build_bvh(moved, config);
                 check_invariants(bvh, moved, config);
                 // At 1e-4 scale and 1e5 offset float spacing (~0.008) exceeds the sphere: it
                 // collapses to a point, so only the well-conditioned cases must match.
-                if (shift == 0.f || scale >= 1.f) CHECK(bvh.stats.sah_cost == Approx(reference).epsilon(0.05));
+                if (shift == 0.f || scale >= 1.f)
+                    CHECK(bvh.stats.sah_cost == Approx(reference).epsilon(0.05));
             }
         }
 }
@@ -222,8 +230,10 @@ TEST_CASE("The SAH cost does not depend on scale or position", "[bvh]") {
 TEST_CASE("Bad input and bad configs are rejected with a clear message", "[bvh]") {
     const std::vector<Triangle> one{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, 0}};
     CHECK_THROWS_WITH(build_bvh(std::vector<Triangle>{}), Catch::Contains("no triangles"));
-    CHECK_THROWS_WITH(build_bvh(one, {.max_leaf_size = 0}), Catch::Contains("max_leaf_size must be in 1..8"));
-    CHECK_THROWS_WITH(build_bvh(one, {.max_leaf_size = 9}), Catch::Contains("max_leaf_size must be in 1..8"));
+    CHECK_THROWS_WITH(build_bvh(one, {.max_leaf_size = 0}),
+                      Catch::Contains("max_leaf_size must be in 1..8"));
+    CHECK_THROWS_WITH(build_bvh(one, {.max_leaf_size = 9}),
+                      Catch::Contains("max_leaf_size must be in 1..8"));
     CHECK_THROWS_WITH(build_bvh(one, {.bins = 1}), Catch::Contains("bins"));
     std::vector<Triangle> bad = one;
     bad[0].v1.y = std::numeric_limits<float>::quiet_NaN();

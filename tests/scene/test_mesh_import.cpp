@@ -7,12 +7,13 @@
 using namespace tpsim::scene;
 using tpsim::scene::testing::write_file;
 
-TEST_CASE("OBJ: quads are triangulated, degenerate faces kept and counted, lines skipped", "[import]") {
+TEST_CASE("OBJ: quads are triangulated, degenerate faces kept and counted, lines skipped",
+          "[import]") {
     const auto path = write_file("quad.obj",
                                  "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\n"
-                                 "f 1 2 3 4\n"   // quad -> 2 triangles
-                                 "f 1 2 5\n"     // collinear -> degenerate, kept
-                                 "l 1 3\n");     // a line: not a triangle
+                                 "f 1 2 3 4\n"  // quad -> 2 triangles
+                                 "f 1 2 5\n"    // collinear -> degenerate, kept
+                                 "l 1 3\n");    // a line: not a triangle
     const ImportedMesh mesh = import_mesh(path);
     CHECK(mesh.triangles.size() == 3);
     CHECK(mesh.summary.triangles == 3);
@@ -21,15 +22,16 @@ TEST_CASE("OBJ: quads are triangulated, degenerate faces kept and counted, lines
 }
 
 TEST_CASE("PLY and OFF files import", "[import]") {
-    const auto ply = write_file("tri.ply",
-                                "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                                "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
-                                "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+    const auto ply = write_file(
+        "tri.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                   "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+                   "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
     const ImportedMesh from_ply = import_mesh(ply);
     REQUIRE(from_ply.triangles.size() == 1);
     CHECK(from_ply.triangles[0].v1 == glm::vec3(1, 0, 0));
 
-    const auto off = write_file("square.off", "OFF\n4 1 0\n0 0 0\n2 0 0\n2 2 0\n0 2 0\n4 0 1 2 3\n");
+    const auto off =
+        write_file("square.off", "OFF\n4 1 0\n0 0 0\n2 0 0\n2 2 0\n0 2 0\n4 0 1 2 3\n");
     const ImportedMesh from_off = import_mesh(off);
     CHECK(from_off.triangles.size() == 2);
     const Aabb box = bounds_of(from_off.triangles);
@@ -38,23 +40,27 @@ TEST_CASE("PLY and OFF files import", "[import]") {
 }
 
 TEST_CASE("Missing, empty, malformed and unsupported mesh files give clear errors", "[import]") {
-    CHECK_THROWS_WITH(import_mesh("/nonexistent/dir/x.obj"), Catch::Contains("mesh file not found"));
+    CHECK_THROWS_WITH(import_mesh("/nonexistent/dir/x.obj"),
+                      Catch::Contains("mesh file not found"));
     CHECK_THROWS_WITH(import_mesh(write_file("empty.obj", "")), Catch::Contains("empty.obj"));
-    CHECK_THROWS_WITH(import_mesh(write_file("bad.ply", "ply\nformat ascii 1.0\nelement vertex 3\nend_header\n1 2")),
+    CHECK_THROWS_WITH(import_mesh(write_file(
+                          "bad.ply", "ply\nformat ascii 1.0\nelement vertex 3\nend_header\n1 2")),
                       Catch::Contains("bad.ply"));
-    CHECK_THROWS_WITH(import_mesh(write_file("bad.off", "OFF\n3 1 0\n0 0 0\n")), Catch::Contains("bad.off"));
+    CHECK_THROWS_WITH(import_mesh(write_file("bad.off", "OFF\n3 1 0\n0 0 0\n")),
+                      Catch::Contains("bad.off"));
     CHECK_THROWS_WITH(import_mesh(write_file("only_points.obj", "v 0 0 0\nv 1 0 0\np 1\np 2\n")),
                       Catch::Contains("no triangles"));
-    CHECK_THROWS_WITH(import_mesh(write_file("notes.xyzzy", "hello")), Catch::Contains("not a mesh format"));
+    CHECK_THROWS_WITH(import_mesh(write_file("notes.xyzzy", "hello")),
+                      Catch::Contains("not a mesh format"));
     CHECK_THROWS_AS(load_scene(write_file("notes.txt2", "hello")), SceneError);
 }
 
-TEST_CASE("A bare mesh gets a camera that sees all of it, a light and a material", "[import][framing]") {
+TEST_CASE("A bare mesh gets a camera that sees all of it, a light and a material",
+          "[import][framing]") {
     // A long, thin, off-centre box: the hard case for framing.
-    const auto path = write_file("stick.obj",
-                                 "v 100 5 -3\nv 160 5 -3\nv 160 7 -3\nv 100 7 -3\n"
-                                 "v 100 5 -1\nv 160 5 -1\nv 160 7 -1\nv 100 7 -1\n"
-                                 "f 1 2 3 4\nf 5 6 7 8\nf 1 2 6 5\nf 4 3 7 8\n");
+    const auto path = write_file("stick.obj", "v 100 5 -3\nv 160 5 -3\nv 160 7 -3\nv 100 7 -3\n"
+                                              "v 100 5 -1\nv 160 5 -1\nv 160 7 -1\nv 100 7 -1\n"
+                                              "f 1 2 3 4\nf 5 6 7 8\nf 1 2 6 5\nf 4 3 7 8\n");
     const Scene scene = load_scene(path);
     REQUIRE(scene.triangles.size() == 8);
     REQUIRE(scene.lights.size() == 1);
@@ -80,10 +86,12 @@ TEST_CASE("A bare mesh gets a camera that sees all of it, a light and a material
     CHECK(scene.lights[0].color.x / glm::dot(to_light, to_light) == Approx(1.0).epsilon(1e-4));
 }
 
-TEST_CASE("Every truncation of a valid OBJ, PLY and OFF file loads or fails cleanly", "[import][robustness]") {
+TEST_CASE("Every truncation of a valid OBJ, PLY and OFF file loads or fails cleanly",
+          "[import][robustness]") {
     const std::pair<std::string, std::string> files[] = {
         {"cut.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nf 1 3 4\n"},
-        {"cut.ply", "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+        {"cut.ply", "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float "
+                    "y\nproperty float z\n"
                     "element face 2\nproperty list uchar int vertex_indices\nend_header\n"
                     "0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n"},
         {"cut.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n4 0 1 2 3\n"},

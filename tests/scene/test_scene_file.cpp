@@ -30,7 +30,8 @@ std::string error_of(const std::filesystem::path& path) {
 }
 
 bool has_material(const Scene& scene, const std::string& name) {
-    return std::any_of(scene.materials.begin(), scene.materials.end(), [&](const Material& m) { return m.name == name; });
+    return std::any_of(scene.materials.begin(), scene.materials.end(),
+                       [&](const Material& m) { return m.name == name; });
 }
 
 }  // namespace
@@ -119,10 +120,12 @@ TEST_CASE("File materials are used when the scene does not override them", "[sce
     CHECK(glm::length(s.camera.eye - s.camera.look_at) > 0.f);
 }
 
-TEST_CASE("Out-of-range values name file, line, column, key and the allowed range", "[scenefile][errors]") {
+TEST_CASE("Out-of-range values name file, line, column, key and the allowed range",
+          "[scenefile][errors]") {
     // Line 3 is "fov = 190"; the value starts at column 7.
-    const auto path = scene_with("bad_fov.toml", "[camera]\neye = [0, 0, 5]\nfov = 190\nlook_at = [0, 0, 0]\n"
-                                                 "[[meshes]]\npath = \"tri.obj\"\n");
+    const auto path =
+        scene_with("bad_fov.toml", "[camera]\neye = [0, 0, 5]\nfov = 190\nlook_at = [0, 0, 0]\n"
+                                   "[[meshes]]\npath = \"tri.obj\"\n");
     CHECK(error_of(path) == path.string() + ":3:7: camera.fov must be in (0, 180), got 190");
 
     CHECK_THAT(error_of(scene_with("w.toml", "[image]\nwidth = 0\n")),
@@ -133,16 +136,19 @@ TEST_CASE("Out-of-range values name file, line, column, key and the allowed rang
                Catch::Contains("materials.red[0] must be in [0, 1], got 1.5"));
     CHECK_THAT(error_of(scene_with("s.toml", "[[meshes]]\npath = \"tri.obj\"\nscale = 0\n")),
                Catch::Contains("meshes[0].scale must be in"));
-    CHECK_THAT(error_of(scene_with("g.toml", "[[generators]]\ntype = \"terrain\"\ncells = [0, 4]\n")),
-               Catch::Contains("generators[0].cells[0] must be in [1, 16384], got 0"));
+    CHECK_THAT(
+        error_of(scene_with("g.toml", "[[generators]]\ntype = \"terrain\"\ncells = [0, 4]\n")),
+        Catch::Contains("generators[0].cells[0] must be in [1, 16384], got 0"));
 }
 
 TEST_CASE("Unknown keys are errors, at any depth", "[scenefile][errors]") {
     CHECK_THAT(error_of(scene_with("k1.toml", "colour = [1, 1, 1]\n")),
                Catch::Contains(":1:1: unknown key colour (allowed: name, image"));
-    CHECK_THAT(error_of(scene_with("k2.toml", "[camera]\neye = [0, 0, 5]\nlook_at = [0, 0, 0]\nfovv = 40\n")),
+    CHECK_THAT(error_of(scene_with("k2.toml",
+                                   "[camera]\neye = [0, 0, 5]\nlook_at = [0, 0, 0]\nfovv = 40\n")),
                Catch::Contains(":4:1: unknown key camera.fovv"));
-    CHECK_THAT(error_of(scene_with("k3.toml", "[[meshes]]\npath = \"tri.obj\"\ntranslation = [1, 2, 3]\n")),
+    CHECK_THAT(error_of(scene_with("k3.toml",
+                                   "[[meshes]]\npath = \"tri.obj\"\ntranslation = [1, 2, 3]\n")),
                Catch::Contains("unknown key meshes[0].translation"));
     CHECK_THAT(error_of(scene_with("k4.toml", "[[lights]]\nposition = [0, 0, 0]\npower = 3\n")),
                Catch::Contains("unknown key lights[0].power"));
@@ -153,31 +159,41 @@ TEST_CASE("Type errors, missing keys and bad references are reported", "[scenefi
                Catch::Contains("image.width must be an integer, got a string"));
     CHECK_THAT(error_of(scene_with("t2.toml", "[camera]\neye = [0, 0]\nlook_at = [0, 0, 0]\n")),
                Catch::Contains("camera.eye must be an array of 3 numbers"));
-    CHECK_THAT(error_of(scene_with("t3.toml", "[camera]\nlook_at = [0, 0, 0]\n[[meshes]]\npath = \"tri.obj\"\n")),
+    CHECK_THAT(error_of(scene_with(
+                   "t3.toml", "[camera]\nlook_at = [0, 0, 0]\n[[meshes]]\npath = \"tri.obj\"\n")),
                Catch::Contains("camera.eye is required"));
-    CHECK_THAT(error_of(scene_with("t4.toml", "[[meshes]]\nscale = 2\n")), Catch::Contains("meshes[0].path is required"));
-    CHECK_THAT(error_of(scene_with("t5.toml", "[[meshes]]\npath = \"tri.obj\"\nmaterial = \"gold\"\n")),
-               Catch::Contains("meshes[0].material 'gold' is not defined in [materials]"));
+    CHECK_THAT(error_of(scene_with("t4.toml", "[[meshes]]\nscale = 2\n")),
+               Catch::Contains("meshes[0].path is required"));
+    CHECK_THAT(
+        error_of(scene_with("t5.toml", "[[meshes]]\npath = \"tri.obj\"\nmaterial = \"gold\"\n")),
+        Catch::Contains("meshes[0].material 'gold' is not defined in [materials]"));
     CHECK_THAT(error_of(scene_with("t6.toml", "[[generators]]\ntype = \"torus\"\n")),
-               Catch::Contains("generators[0].type must be one of sphere, terrain, sphere_grid, got 'torus'"));
+               Catch::Contains(
+                   "generators[0].type must be one of sphere, terrain, sphere_grid, got 'torus'"));
     CHECK_THAT(error_of(scene_with("t7.toml", "[camera]\neye = [1, 1, 1]\nlook_at = [1, 1, 1]\n"
                                               "[[meshes]]\npath = \"tri.obj\"\n")),
                Catch::Contains("camera.eye and camera.look_at must differ"));
     CHECK_THAT(error_of(scene_with("t8.toml", "[shading]\nshadows = 1\n")),
                Catch::Contains("shading.shadows must be true or false"));
-    CHECK_THAT(error_of(scene_with("t9.toml", "meshes = 3\n")), Catch::Contains("meshes must be an array of tables"));
+    CHECK_THAT(error_of(scene_with("t9.toml", "meshes = 3\n")),
+               Catch::Contains("meshes must be an array of tables"));
 }
 
 TEST_CASE("Syntax errors, missing files and empty scenes are reported", "[scenefile][errors]") {
-    CHECK_THAT(error_of(scene_with("syntax.toml", "[image]\nwidth = = 3\n")), Catch::Contains("syntax.toml:2:"));
-    CHECK_THAT(error_of(scene_with("syntax.toml", "[image]\nwidth = = 3\n")), Catch::Contains("TOML syntax"));
+    CHECK_THAT(error_of(scene_with("syntax.toml", "[image]\nwidth = = 3\n")),
+               Catch::Contains("syntax.toml:2:"));
+    CHECK_THAT(error_of(scene_with("syntax.toml", "[image]\nwidth = = 3\n")),
+               Catch::Contains("TOML syntax"));
     CHECK_THAT(error_of(write_file("nothing_here.toml", "").parent_path() / "absent.toml"),
                Catch::Contains("scene file not found"));
-    CHECK_THAT(error_of(scene_with("empty.toml", "name = \"x\"\n")), Catch::Contains("the scene has no geometry"));
+    CHECK_THAT(error_of(scene_with("empty.toml", "name = \"x\"\n")),
+               Catch::Contains("the scene has no geometry"));
     // A missing mesh is reported at the path value inside the scene file (line 2, column 8).
     CHECK_THAT(error_of(scene_with("nomesh.toml", "[[meshes]]\npath = \"missing.obj\"\n")),
-               Catch::Contains("nomesh.toml:2:8: meshes[0].path:") && Catch::Contains("mesh file not found"));
-    CHECK_THAT(error_of(scene_with("huge.toml", "[[generators]]\ntype = \"terrain\"\ncells = [16384, 16384]\n")),
+               Catch::Contains("nomesh.toml:2:8: meshes[0].path:") &&
+                   Catch::Contains("mesh file not found"));
+    CHECK_THAT(error_of(scene_with("huge.toml",
+                                   "[[generators]]\ntype = \"terrain\"\ncells = [16384, 16384]\n")),
                Catch::Contains("triangles"));
 }
 
@@ -201,7 +217,8 @@ TEST_CASE("The shipped scenes load", "[scenefile][shipped]") {
     const Scene again = load_scene(dir / "stress.toml");
     CHECK(std::equal(stress.triangles.begin(), stress.triangles.end(), again.triangles.begin(),
                      [](const Triangle& a, const Triangle& b) {
-                         return a.v0 == b.v0 && a.v1 == b.v1 && a.v2 == b.v2 && a.material == b.material;
+                         return a.v0 == b.v0 && a.v1 == b.v1 && a.v2 == b.v2 &&
+                                a.material == b.material;
                      }));
 
     if (std::filesystem::exists("/usr/share/glmark2/models/bunny.obj"))

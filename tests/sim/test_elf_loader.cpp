@@ -44,7 +44,7 @@ struct Patchable {
     Program parse() const { return load_elf(bytes, "patched.elf"); }
 };
 
-} // namespace
+}  // namespace
 
 TEST_CASE("the loader reads segments, entry and symbols of a linked program", "[sim][elf]") {
     const Program p = load_elf(guest_program("loadstore"));
@@ -57,9 +57,9 @@ TEST_CASE("the loader reads segments, entry and symbols of a linked program", "[
     const Segment& data = p.segments.back();
     CHECK(data.writable);
     CHECK_FALSE(data.executable);
-    CHECK(data.memsz == 4 + 8);    // .word + .space 8 (bss)
-    CHECK(data.bytes.size() == 4); // only .data is in the file
-    CHECK(p.entry == text.vaddr);  // _start is the first thing in .text
+    CHECK(data.memsz == 4 + 8);     // .word + .space 8 (bss)
+    CHECK(data.bytes.size() == 4);  // only .data is in the file
+    CHECK(p.entry == text.vaddr);   // _start is the first thing in .text
     REQUIRE(p.function_at(p.entry));
     CHECK(p.function_at(p.entry)->name == "_start");
     CHECK(p.describe_pc(p.entry + 8) == "_start+0x8");
@@ -203,7 +203,7 @@ TEST_CASE("the loader rejects patched headers with a message naming the problem"
 TEST_CASE("randomly corrupted programs load and run or fail with an Error, never crash",
           "[sim][elf]") {
     const std::vector<uint8_t> good = read_bytes(guest_program("calls"));
-    std::mt19937 random(6958); // fixed seed: the same corruptions every run
+    std::mt19937 random(6958);  // fixed seed: the same corruptions every run
     std::uniform_int_distribution<size_t> header_byte(0, 255), any_byte(0, good.size() - 1);
     std::uniform_int_distribution<int> value(0, 255), count(1, 4);
     size_t loaded = 0, rejected = 0;

@@ -45,7 +45,7 @@ std::string fault_message(Machine& m) {
     return "";
 }
 
-} // namespace
+}  // namespace
 
 TEST_CASE("instruction-class programs compute the expected results", "[sim][machine]") {
     // Each program exits with 0 when all of its checks pass, else with the failed check's number.
@@ -93,7 +93,7 @@ TEST_CASE("tp.atominc hands out unique tickets across 1024 threads", "[sim][mach
     CHECK(m.global_register(6) == 0);
     std::vector<uint32_t> claimed(kThreads + 1, 0);
     for (uint32_t ticket = 0; ticket < kThreads * kTicketsEach; ++ticket) {
-        const uint32_t owner = global_word(m, ticket); // mhartid + 1; 0 = never handed out
+        const uint32_t owner = global_word(m, ticket);  // mhartid + 1; 0 = never handed out
         REQUIRE(owner >= 1);
         REQUIRE(owner <= kThreads);
         ++claimed[owner];
@@ -105,7 +105,7 @@ TEST_CASE("tp.atominc hands out unique tickets across 1024 threads", "[sim][mach
 TEST_CASE("faults name kind, thread, pc, function, instruction and a fix", "[sim][machine]") {
     struct Case {
         const char* program;
-        uint32_t victim_offset; // of the faulting instruction in victim()
+        uint32_t victim_offset;  // of the faulting instruction in victim()
         const char* kind;
         const char* detail;
     };
@@ -149,8 +149,9 @@ TEST_CASE("unbounded recursion is a stack overflow in the recursive function", "
     CHECK_THAT(message, Catch::Contains(fmt::format("stack_overflow.c:{})", line)));
     CHECK_THAT(message,
                Catch::Contains("below the 1024-byte local store [0x7ffffc00, 0x80000000)"));
-    CHECK_THAT(message, Catch::EndsWith("reduce recursion/locals or enlarge the local store "
-                                        "(exec --local-store N, render --set tp.local_store_bytes=N)"));
+    CHECK_THAT(message,
+               Catch::EndsWith("reduce recursion/locals or enlarge the local store "
+                               "(exec --local-store N, render --set tp.local_store_bytes=N)"));
 }
 
 TEST_CASE("a runaway thread stops at the instruction limit", "[sim][machine]") {
@@ -166,7 +167,7 @@ TEST_CASE("a runaway thread stops at the instruction limit", "[sim][machine]") {
 TEST_CASE("a fault in one of 1024 threads names that thread", "[sim][machine]") {
     Machine m = machine_for("fault_thread17_ebreak", {.threads = 1024});
     CHECK_THAT(fault_message(m), Catch::StartsWith("breakpoint in thread 17 at pc"));
-    CHECK(m.thread(16).state == ThreadState::Exited); // thread order by id within a round
+    CHECK(m.thread(16).state == ThreadState::Exited);  // thread order by id within a round
     CHECK(m.thread(17).state == ThreadState::Faulted);
 }
 
@@ -184,7 +185,7 @@ TEST_CASE("step() reports each instruction's pc, memory access and control flow"
     CHECK_FALSE(trace.back().taken);
     const auto taken =
         std::count_if(trace.begin(), trace.end(), [](const StepRecord& r) { return r.taken; });
-    CHECK(taken == 0); // loadstore.S is straight-line code: CHECK's bne never branches
+    CHECK(taken == 0);  // loadstore.S is straight-line code: CHECK's bne never branches
     CHECK(trace.back().insn->op == isa::Op::ecall);
     // The first load of the program is `lw t1, 0(t0)` of the .data word.
     const auto first_load = std::find_if(
@@ -200,7 +201,7 @@ TEST_CASE("step() reports each instruction's pc, memory access and control flow"
     CHECK(first_sb->mem_store);
     for (const StepRecord& r : trace)
         if (r.insn->op == isa::Op::addi) CHECK(r.mem_bytes == 0);
-    CHECK_THROWS_AS(m.step(0), Error); // the thread has exited
+    CHECK_THROWS_AS(m.step(0), Error);  // the thread has exited
 }
 
 TEST_CASE("step() marks taken branches and jumps", "[sim][machine]") {

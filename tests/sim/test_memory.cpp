@@ -34,15 +34,15 @@ FaultKind fault_of(const std::function<void()>& access) {
     return FaultKind::Unmapped;
 }
 
-} // namespace
+}  // namespace
 
 TEST_CASE("memory maps program segments with their permissions", "[sim][memory]") {
     Memory m(tiny_program(), {.global_bytes = 64, .local_store_bytes = 256, .threads = 2});
     uint8_t* local = m.local_store(0).data();
-    CHECK(m.load<uint32_t>(kCodeBase + 0x100, local) == 0x04030201u); // little-endian
+    CHECK(m.load<uint32_t>(kCodeBase + 0x100, local) == 0x04030201u);  // little-endian
     CHECK(m.load<int8_t>(kCodeBase + 0x107, local) == 8);
     CHECK(m.load<uint32_t>(kCodeBase + 0x1000, local) == 0x09090909u);
-    CHECK(m.load<uint32_t>(kCodeBase + 0x100c, local) == 0u); // bss part is zero
+    CHECK(m.load<uint32_t>(kCodeBase + 0x100c, local) == 0u);  // bss part is zero
     m.store<uint32_t>(kCodeBase + 0x100c, 0xdeadbeef, local);
     CHECK(m.load<uint16_t>(kCodeBase + 0x100e, local) == 0xdeadu);
     CHECK(fault_of([&] { m.store<uint32_t>(kCodeBase + 0x100, 1, local); }) ==
@@ -61,8 +61,9 @@ TEST_CASE("global memory is shared and visible to the host", "[sim][memory]") {
 }
 
 TEST_CASE("the read-only start of global memory takes loads and refuses stores", "[sim][memory]") {
-    Memory m(tiny_program(), {.global_bytes = 64, .read_only_global_bytes = 16,
-                              .local_store_bytes = 256, .threads = 1});
+    Memory m(
+        tiny_program(),
+        {.global_bytes = 64, .read_only_global_bytes = 16, .local_store_bytes = 256, .threads = 1});
     uint8_t* local = m.local_store(0).data();
     m.global()[12] = 5;  // the host writes the scene before the run
     CHECK(m.load<uint8_t>(kGlobalBase + 12, local) == 5);
@@ -106,7 +107,7 @@ TEST_CASE("memory faults: null, unmapped, misaligned", "[sim][memory]") {
     CHECK(fault_of([&] { m.load<uint32_t>(kCodeBase + 0x1002, local); }) == FaultKind::Misaligned);
     CHECK(fault_of([&] { m.load<uint16_t>(kGlobalBase + 1, local); }) == FaultKind::Misaligned);
     CHECK(fault_of([&] { m.store<uint32_t>(kLocalTop - 6, 0, local); }) == FaultKind::Misaligned);
-    CHECK(m.load<uint8_t>(kGlobalBase + 1, local) == 0); // bytes have no alignment
+    CHECK(m.load<uint8_t>(kGlobalBase + 1, local) == 0);  // bytes have no alignment
     try {
         m.store<uint32_t>(kLocalTop - 260, 1, local);
         FAIL("no fault");

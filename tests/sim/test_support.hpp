@@ -30,4 +30,4 @@ inline uint32_t line_of(const std::string& file, const std::string& marker) {
     return 0;
 }
 
-} // namespace tpsim::test
+}  // namespace tpsim::test

@@ -10,8 +10,12 @@ namespace {
 const CacheConfig kSmall{1024, 2, 64, 2, 3, 2};
 constexpr uint32_t kSetStride = 8 * 64;  // addresses this far apart share a set
 
-MemRequest load(uint32_t addr, uint32_t tag = 0) { return {addr, 0, tag, false}; }
-MemRequest store(uint32_t addr) { return {addr, 0, 0, true}; }
+MemRequest load(uint32_t addr, uint32_t tag = 0) {
+    return {addr, 0, tag, false};
+}
+MemRequest store(uint32_t addr) {
+    return {addr, 0, 0, true};
+}
 
 // Fake next level: answers every outbound read `latency` cycles after it becomes visible.
 void serve_next_level(Cache& cache, uint32_t latency) {
@@ -48,7 +52,7 @@ TEST_CASE("a miss goes to the next level and returns after its latency plus two 
     Cache cache(kSmall);
     REQUIRE(cache.access(0, load(0x1234)) == CacheOutcome::Miss);
     REQUIRE(cache.outbound().size() == 1);
-    CHECK(cache.outbound().front().cycle == 3);          // after the tag lookup
+    CHECK(cache.outbound().front().cycle == 3);              // after the tag lookup
     CHECK(cache.outbound().front().request.addr == 0x1200);  // whole line
     serve_next_level(cache, 20);
     CHECK(reply_cycle(cache, 0) == 3 + 20 + 3);  // lookup, next level, fill-to-use
@@ -72,7 +76,7 @@ TEST_CASE("MSHRs merge misses to one line and limit distinct outstanding lines",
         ++woken;
         CHECK(reply.ready == 53);
     }
-    CHECK(woken == 3);  // tags 1, 2 and 5
+    CHECK(woken == 3);                                           // tags 1, 2 and 5
     CHECK(cache.access(54, load(0x080)) == CacheOutcome::Miss);  // MSHR freed
     const auto& c = cache.counters();
     CHECK(c.misses == 3);
@@ -122,8 +126,7 @@ TEST_CASE("stores are write-around: forwarded, never allocated, no reply", "[cac
     CHECK(cache.counters().writes == 2);
 }
 
-TEST_CASE("I-cache banks: one address per bank per cycle, shared addresses broadcast",
-          "[icache]") {
+TEST_CASE("I-cache banks: one address per bank per cycle, shared addresses broadcast", "[icache]") {
     ICacheBanks icache(ICacheConfig{16, 4}, 32);
     auto fetch = [&](uint64_t now, uint32_t tp, uint32_t pc) {
         const auto tp_of = [&](uint32_t) { return tp; };

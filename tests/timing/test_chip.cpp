@@ -17,8 +17,12 @@ namespace stats = tpsim::stats;
 
 namespace {
 
-constexpr uint8_t x(uint8_t i) { return i; }
-constexpr uint8_t f(uint8_t i) { return isa::kFpBase + i; }
+constexpr uint8_t x(uint8_t i) {
+    return i;
+}
+constexpr uint8_t f(uint8_t i) {
+    return isa::kFpBase + i;
+}
 
 // Fake functional core: a fixed instruction trace per thread.
 class Script : public InstructionSource {
@@ -66,13 +70,16 @@ ChipConfig one_tp() {
     return c;
 }
 
-uint64_t stat(const stats::Registry& r, std::string_view name) { return r.at(name).integer(); }
+uint64_t stat(const stats::Registry& r, std::string_view name) {
+    return r.at(name).integer();
+}
 
 }  // namespace
 
 TEST_CASE("independent ALU instructions issue one per cycle", "[chip]") {
     Script s(1);
-    for (int i = 0; i < 10; ++i) s.add(0, Op::add, x(5 + i % 3), x(1), x(2));
+    for (int i = 0; i < 10; ++i)
+        s.add(0, Op::add, x(5 + i % 3), x(1), x(2));
     s.finish();
     Chip chip(one_tp(), s);
     CHECK(chip.run() == 11);  // 10 adds + the exiting ecall, one per cycle
@@ -83,7 +90,8 @@ TEST_CASE("a dependent chain waits for the producing unit's latency", "[chip]") 
     c.fu.fp_mul.latency = 3;
     Script s(1);
     const int n = 5;
-    for (int i = 0; i < n; ++i) s.add(0, Op::fmul_s, f(1), f(1), f(2));  // f1 = f1 * f2
+    for (int i = 0; i < n; ++i)
+        s.add(0, Op::fmul_s, f(1), f(1), f(2));  // f1 = f1 * f2
     s.finish();
     Chip chip(c, s);
     stats::Registry r;
@@ -103,7 +111,8 @@ TEST_CASE("latencies and penalties longer than the sleep wheel are exact", "[chi
     c.fu.fp_mul.latency = 5000;
     c.tp.branch_taken_penalty = 1000;
     Script s(2);
-    for (int i = 0; i < 3; ++i) s.add(0, Op::fmul_s, f(1), f(1), f(2));  // f1 = f1 * f2
+    for (int i = 0; i < 3; ++i)
+        s.add(0, Op::fmul_s, f(1), f(1), f(2));  // f1 = f1 * f2
     s.add(1, Op::beq, isa::kNoReg, x(1), x(2), 0, true);
     s.add(1, Op::add, x(3), x(1), x(2));
     s.finish();
@@ -139,7 +148,8 @@ TEST_CASE("TPs sharing one unit take turns; refusals are FU-busy stalls", "[chip
     Script s(4);
     const int n = 8;
     for (uint32_t t = 0; t < 4; ++t)
-        for (int i = 0; i < n; ++i) s.add(t, Op::fadd_s, f(3 + i % 4), f(1), f(2));
+        for (int i = 0; i < n; ++i)
+            s.add(t, Op::fadd_s, f(3 + i % 4), f(1), f(2));
     s.finish();
     Chip chip(c, s);
     stats::Registry r;
@@ -148,8 +158,8 @@ TEST_CASE("TPs sharing one unit take turns; refusals are FU-busy stalls", "[chip
     CHECK(cycles >= 4 * n);      // one fadd per cycle for the whole TM
     CHECK(cycles <= 4 * n + 4);  // plus the exits
     CHECK(stat(r, "tm0/fu/fp_add/issued") == 4 * n);
-    CHECK(stat(r, "tm0/stalls/fu_busy") == stat(r, "tm0/fu/fp_add/denied") +
-                                               stat(r, "tm0/fu/int_alu/denied"));
+    CHECK(stat(r, "tm0/stalls/fu_busy") ==
+          stat(r, "tm0/fu/fp_add/denied") + stat(r, "tm0/fu/int_alu/denied"));
 }
 
 TEST_CASE("a load miss costs L1, L2 and DRAM latencies; the next access to the line hits",
@@ -263,8 +273,9 @@ TEST_CASE("every registered key is documented in docs/statistics.md", "[chip][do
     stats::Registry r;
     chip.register_stats(r);
     for (const stats::Entry& e : r.entries()) {
-        const bool found = std::any_of(documented.begin(), documented.end(),
-                                       [&](const std::regex& re) { return std::regex_match(e.name, re); });
+        const bool found =
+            std::any_of(documented.begin(), documented.end(),
+                        [&](const std::regex& re) { return std::regex_match(e.name, re); });
         INFO(e.name);
         CHECK(found);
     }

@@ -28,8 +28,7 @@ TEST_CASE("the tiny preset is 1 TM x 4 TPs and keeps unlisted defaults", "[confi
 
 TEST_CASE("errors name the source line, the key and the allowed range", "[config]") {
     CHECK_THROWS_WITH(parse_config("[l1]\nsize_bytes = 32768\nways = 0\n", "x.toml"),
-                      Contains("x.toml:3") && Contains("l1.ways = 0") &&
-                          Contains("allowed 1..64"));
+                      Contains("x.toml:3") && Contains("l1.ways = 0") && Contains("allowed 1..64"));
     CHECK_THROWS_WITH(parse_config("[l1]\nsise_bytes = 1\n", "x.toml"),
                       Contains("x.toml:2") && Contains("unknown key 'l1.sise_bytes'"));
     CHECK_THROWS_WITH(parse_config("[fu.fp_add]\npipelined = 3\n", "x.toml"),
@@ -45,8 +44,7 @@ TEST_CASE("cross-field rules are checked", "[config]") {
                       Contains("l1.size_bytes = 3000 must be a power-of-two multiple"));
     CHECK_THROWS_WITH(parse_config("[l2]\nline_bytes = 128\n", "x.toml"),
                       Contains("must equal l1.line_bytes"));
-    CHECK_THROWS_WITH(parse_config("[l1]\nline_bytes = 48\n", "x.toml"),
-                      Contains("power of two"));
+    CHECK_THROWS_WITH(parse_config("[l1]\nline_bytes = 48\n", "x.toml"), Contains("power of two"));
     CHECK_THROWS_WITH(parse_config("[dram]\ntRAS = 5\n", "x.toml"), Contains("dram.tRAS"));
 }
 

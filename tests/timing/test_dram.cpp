@@ -22,7 +22,8 @@ DramConfig one_channel() {
 
 // Sends one read at `at` (after ticking up to it) and returns its reply cycle.
 uint64_t read_latency(Dram& dram, uint64_t& now, uint64_t at, uint32_t addr) {
-    for (; now < at; ++now) dram.tick(now);
+    for (; now < at; ++now)
+        dram.tick(now);
     REQUIRE(dram.enqueue(now, {addr, 0, 0, false}));
     MemReply reply;
     for (;; ++now) {
@@ -74,14 +75,15 @@ TEST_CASE("FR-FCFS serves a younger row hit before an older row conflict", "[dra
     const DramConfig c = one_channel();
     Dram dram(c, kLine);
     uint64_t now = 0;
-    read_latency(dram, now, 0, 0x000);  // opens row 0 of bank 0
+    read_latency(dram, now, 0, 0x000);                           // opens row 0 of bank 0
     REQUIRE(dram.enqueue(now, {2 * c.row_bytes, 0, 1, false}));  // older, conflicts
     REQUIRE(dram.enqueue(now, {0x080, 0, 2, false}));            // younger, hits
     std::vector<uint32_t> order;
     MemReply reply;
     for (uint64_t end = now + 200; now < end; ++now) {
         dram.tick(now);
-        while (dram.pop_reply(now, reply)) order.push_back(reply.request.tag);
+        while (dram.pop_reply(now, reply))
+            order.push_back(reply.request.tag);
     }
     CHECK(order == std::vector<uint32_t>{2, 1});
 }
@@ -101,7 +103,8 @@ TEST_CASE("a streaming pattern reaches the configured bandwidth and no more", "[
             next_addr += kLine;
         }
         dram.tick(now);
-        while (dram.pop_reply(now, reply)) bytes += kLine;
+        while (dram.pop_reply(now, reply))
+            bytes += kLine;
     }
     const double achieved = double(bytes) / cycles;
     CHECK(achieved <= peak);
@@ -117,7 +120,8 @@ TEST_CASE("writes use the bus, need no reply, and full queues refuse requests", 
     CHECK(dram.enqueue(0, {0x000, 0, 0, true}));
     CHECK(dram.enqueue(0, {0x040, 0, 0, true}));
     CHECK_FALSE(dram.enqueue(0, {0x080, 0, 0, true}));
-    for (uint64_t now = 0; now < 100; ++now) dram.tick(now);
+    for (uint64_t now = 0; now < 100; ++now)
+        dram.tick(now);
     MemReply reply;
     CHECK_FALSE(dram.pop_reply(100, reply));
     CHECK(dram.idle());
@@ -140,7 +144,8 @@ TEST_CASE("DRAM is deterministic for a fixed request pattern", "[dram][determini
             const uint32_t addr = (lcg >> 8) % (1u << 16) & ~(kLine - 1);
             if (now % 3 == 0) dram.enqueue(now, {addr, 0, uint32_t(now), (lcg & 1) != 0});
             dram.tick(now);
-            while (dram.pop_reply(now, reply)) replies.emplace_back(reply.ready, reply.request.tag);
+            while (dram.pop_reply(now, reply))
+                replies.emplace_back(reply.ready, reply.request.tag);
         }
         return replies;
     };
@@ -161,11 +166,12 @@ TEST_CASE("global registers serve in (arrival, TM, sequence) order with fixed la
     AtomicReply reply;
     for (uint64_t now = 0; now < 40; ++now) {
         unit.tick(now);
-        while (unit.pop_reply(now, reply)) got.emplace_back(reply.ready, reply.request.tp);
+        while (unit.pop_reply(now, reply))
+            got.emplace_back(reply.ready, reply.request.tp);
     }
     const uint64_t first = 10 + c.link_latency + c.latency + c.link_latency;
-    CHECK(got == std::vector<std::pair<uint64_t, uint32_t>>{
-                     {first, 4}, {first + 1, 5}, {first + 2, 7}});
+    CHECK(got ==
+          std::vector<std::pair<uint64_t, uint32_t>>{{first, 4}, {first + 1, 5}, {first + 2, 7}});
     CHECK(unit.counters().queued_cycles == 0 + 1 + 2);
     CHECK(unit.idle());
 }

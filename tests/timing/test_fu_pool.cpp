@@ -24,7 +24,8 @@ std::vector<uint64_t> saturate(FuPool& pool, uint32_t requesters, uint64_t cycle
     for (uint64_t now = 0; now < cycles; ++now) {
         for (uint32_t id = 0; id < requesters; ++id)
             pool.request(id / 64, uint64_t{1} << (id % 64));
-        for (uint32_t id : winners_of(pool, now, requesters)) ++grants[id];
+        for (uint32_t id : winners_of(pool, now, requesters))
+            ++grants[id];
     }
     return grants;
 }
@@ -41,7 +42,8 @@ TEST_CASE("a pipelined pool starts `count` operations per cycle, shared fairly",
     FuPool wide(FuConfig{3, 2, true}, 4);
     const auto wide_grants = saturate(wide, 4, 100);
     CHECK(wide.counters().issued == 300);  // 3 units, one issue each per cycle
-    for (uint64_t g : wide_grants) CHECK(g == 75);
+    for (uint64_t g : wide_grants)
+        CHECK(g == 75);
 }
 
 TEST_CASE("a blocking pool is busy for its latency", "[fu]") {
@@ -49,7 +51,8 @@ TEST_CASE("a blocking pool is busy for its latency", "[fu]") {
     const auto grants = saturate(pool, 3, 120);
     CHECK(pool.counters().issued == 2 * 120 / 4);  // throughput count / latency
     CHECK(pool.counters().unit_busy_cycles == 240);
-    for (uint64_t g : grants) CHECK(g == 20);
+    for (uint64_t g : grants)
+        CHECK(g == 20);
 }
 
 TEST_CASE("a pool of more than 64 requesters shares fairly too", "[fu]") {
@@ -73,7 +76,8 @@ TEST_CASE("rotating priority: the last winner goes to the back", "[fu]") {
         pool.request(0, uint64_t{1} << 2);  // request order must not matter
         pool.request(0, uint64_t{1} << 0);
         pool.request(0, uint64_t{1} << 1);
-        for (uint32_t id : winners_of(pool, now, 3)) order.push_back(id);
+        for (uint32_t id : winners_of(pool, now, 3))
+            order.push_back(id);
     }
     CHECK(order == std::vector<uint32_t>{0, 1, 2, 0, 1, 2});
 }

@@ -1,10 +1,10 @@
 // End to end on the tracer kernel: the cycle-level engine is deterministic and never changes
 // the image, whatever the timing parameters (functional-first: timing decides only *when*).
+#include "sim/core/elf_loader.hpp"
+#include "sim/image/memory_image.hpp"
 #include "sim/render/render.hpp"
 #include "sim/render/report.hpp"
 #include "sim/render/timing_run.hpp"
-#include "sim/core/elf_loader.hpp"
-#include "sim/image/memory_image.hpp"
 #include "sim/scene/bvh.hpp"
 #include "sim/scene/load_scene.hpp"
 #include "timing/config.hpp"
@@ -29,7 +29,8 @@ namespace {
 
 std::string replaced(std::string text, const std::string& from, const std::string& to) {
     const size_t at = text.find(from);
-    if (at == std::string::npos) throw std::runtime_error("scenes/cornell.toml has no '" + from + "'");
+    if (at == std::string::npos)
+        throw std::runtime_error("scenes/cornell.toml has no '" + from + "'");
     return text.replace(at, from.size(), to);
 }
 
@@ -57,7 +58,9 @@ render::RenderResult render_cornell(render::Engine engine, const timing::ChipCon
     return render::render(options);
 }
 
-timing::ChipConfig tiny() { return timing::load_config(TPSIM_CONFIG_DIR "/tiny.toml"); }
+timing::ChipConfig tiny() {
+    return timing::load_config(TPSIM_CONFIG_DIR "/tiny.toml");
+}
 
 bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
     return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
@@ -96,7 +99,8 @@ TEST_CASE("timing parameters never change the image", "[render][invariance]") {
     uint64_t previous_cycles = 0;
     for (const auto& overrides : variants) {
         timing::ChipConfig chip = tiny();
-        for (const char* o : overrides) timing::apply_override(chip, o);
+        for (const char* o : overrides)
+            timing::apply_override(chip, o);
         const auto result = render_cornell(render::Engine::timing, chip);
         INFO(overrides[0] << ' ' << overrides[1]);
         CHECK(same_bits(result.rgb, reference.rgb));
@@ -135,14 +139,13 @@ private:
 };
 
 struct ChipRun {
-    std::string stats;                 // every chip statistic, name=value lines
-    std::vector<uint32_t> global;      // global memory afterwards (framebuffer included)
+    std::string stats;             // every chip statistic, name=value lines
+    std::vector<uint32_t> global;  // global memory afterwards (framebuffer included)
 };
 
 /// Runs the tracer on the 32x32 Cornell box; with `pause_every`, in run_until() steps of that
 /// many cycles.
-template <class Source>
-ChipRun run_chip(const timing::ChipConfig& chip, uint64_t pause_every = 0) {
+template <class Source> ChipRun run_chip(const timing::ChipConfig& chip, uint64_t pause_every = 0) {
     const scene::Scene scene = scene::load_scene(small_cornell());
     scene::BvhConfig bvh_config;
     bvh_config.traversal_stack_entries = trax::layout::kTraversalStackEntries;

@@ -86,7 +86,8 @@ TEST_CASE("JSON values are exact, ordered, and non-finite reals are null", "[sta
     double host = 0.1;
     r.add_counter("b/first", a, "desc with \"quotes\"", "B");
     r.add_number("a/second", host, "host seconds", "s");
-    r.add_derived("c/nan", [] { return 0.0 / 0.0; }, "not a number");
+    r.add_derived(
+        "c/nan", [] { return 0.0 / 0.0; }, "not a number");
     r.add_counter("d/big", big, "largest counter");
     const Snapshot snapshot(r);
     const std::string text = values_json(snapshot).dump();

@@ -89,7 +89,8 @@ void dram_conflicts(uint8_t* g) {
     const ChipConfig c = tiny();
     const uint32_t stride = c.dram.row_bytes * c.dram.channels * c.dram.banks;
     put_word(g, kGlobalBase, kChainBase);
-    for (uint32_t i = 0; i < 130; ++i) put_word(g, kChainBase + stride * i, kChainBase + stride * (i + 1));
+    for (uint32_t i = 0; i < 130; ++i)
+        put_word(g, kChainBase + stride * i, kChainBase + stride * (i + 1));
 }
 
 }  // namespace
@@ -140,7 +141,7 @@ TEST_CASE("dependency chains take each unit's configured latency per step", "[va
     c.fu.fp_divsqrt.latency = 11;
     c.fu.fp_misc.latency = 2;
     const std::pair<const char*, uint32_t> chains[] = {
-        {"chain_add", 1}, {"chain_mul", 4},   {"chain_fadd", 3}, {"chain_fmul", 5},
+        {"chain_add", 1},   {"chain_mul", 4},    {"chain_fadd", 3}, {"chain_fmul", 5},
         {"chain_fdiv", 11}, {"chain_fsqrt", 11}, {"chain_fmin", 2}};
     for (auto [program, latency] : chains) {
         INFO(program);
@@ -192,8 +193,8 @@ TEST_CASE("a streaming kernel saturates the DRAM bandwidth and no more", "[valid
         c.l2.mshrs = 64;
         c.l2.banks = 8;
         const auto run = run_program("stream", c);
-        const double peak = double(channels) * c.l2.line_bytes /
-                            std::max(c.dram.tBURST, c.dram.tCCD);  // B/cycle
+        const double peak =
+            double(channels) * c.l2.line_bytes / std::max(c.dram.tBURST, c.dram.tCCD);  // B/cycle
         const double achieved = run->stats.value("chip/dram/bandwidth_bytes_per_cycle");
         INFO("channels " << channels << ": " << achieved << " of " << peak << " B/cycle");
         CHECK(run->stat("dram/bytes_read") == 2048 * 64);

@@ -2,5 +2,6 @@
 #include "trax.hpp"
 
 void trax_main() {
-    for (;;) asm volatile("");
+    for (;;)
+        asm volatile("");
 }

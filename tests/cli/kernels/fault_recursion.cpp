@@ -9,4 +9,6 @@ int depth(int n) {
 }
 }  // namespace
 
-void trax_main() { storei(depth(1 << 20), trax_framebuffer(), 0); }
+void trax_main() {
+    storei(depth(1 << 20), trax_framebuffer(), 0);
+}

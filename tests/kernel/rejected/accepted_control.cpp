@@ -8,7 +8,8 @@ struct Big {
 
 __attribute__((noinline)) Big fill(float seed) {
     Big b{};
-    for (int i = 0; i < 24; i += 5) b.values[i] = seed * static_cast<float>(i);
+    for (int i = 0; i < 24; i += 5)
+        b.values[i] = seed * static_cast<float>(i);
     return b;
 }
 

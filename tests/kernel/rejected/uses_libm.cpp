@@ -3,6 +3,10 @@
 
 extern "C" float sinf(float);
 
-float wave(float x) { return sinf(x); }
+float wave(float x) {
+    return sinf(x);
+}
 
-void trax_main() { storef(wave(loadf(0, 7)), trax_framebuffer()); }
+void trax_main() {
+    storef(wave(loadf(0, 7)), trax_framebuffer());
+}

@@ -10,7 +10,9 @@ struct Square : Shape {
 };
 
 // noinline keeps the call virtual, as it would be in a real kernel with several shapes.
-__attribute__((noinline)) float area_of(const Shape& s) { return s.area(); }
+__attribute__((noinline)) float area_of(const Shape& s) {
+    return s.area();
+}
 
 void trax_main() {
     Square square;

@@ -10,4 +10,6 @@ static inline __attribute__((noreturn)) void guest_exit(int code) {
 
 int main(void);
 
-__attribute__((section(".text.start"), noreturn)) void _start(void) { guest_exit(main()); }
+__attribute__((section(".text.start"), noreturn)) void _start(void) {
+    guest_exit(main());
+}
