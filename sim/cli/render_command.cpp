@@ -100,6 +100,7 @@ struct RenderCommandOptions {
     std::string annotate;
     std::string heatmap;
     std::string heatmap_metric = "cycles";
+    std::string heatmap_scale = "log";
     std::string html;
     uint64_t max_instructions = uint64_t(1) << 32;
 };
@@ -129,6 +130,7 @@ int run_render(const RenderCommandOptions& o) {
     // Read now, so a missing package is found before the run.
     const std::string chart_js = o.html.empty() ? "" : analysis::load_chart_js();
     const render::HeatMetric heat_metric = render::parse_heat_metric(o.heatmap_metric);
+    const render::HeatScale heat_scale = render::parse_heat_scale(o.heatmap_scale);
     if (!o.heatmap.empty()) render::check_heatmap_path(o.heatmap);
     options.profile = o.profile || !o.annotate.empty();
     if (options.engine != render::Engine::timing) {
@@ -164,7 +166,7 @@ int run_render(const RenderCommandOptions& o) {
     if (!o.heatmap.empty()) {
         const render::HeatmapFiles files =
             render::write_heatmap(o.heatmap, result.timing->chip->work_items(), result.scene.width,
-                                  result.scene.height, heat_metric);
+                                  result.scene.height, heat_metric, heat_scale);
         fmt::print("heatmap  {} ({} per pixel; raw values in {})\n", files.png.string(),
                    render::metric_name(heat_metric), files.exr.string());
         if (!files.legend_problem.empty())
@@ -257,6 +259,11 @@ Command add_render_command(CLI::App& app) {
     command
         ->add_option("--heatmap-metric", o->heatmap_metric,
                      "What the heat map shows: cycles, instructions or dram_bytes per pixel")
+        ->capture_default_str();
+    command
+        ->add_option("--heatmap-scale", o->heatmap_scale,
+                     "How the heat map's colours follow the values: log (a few costly pixels do "
+                     "not darken the rest) or linear")
         ->capture_default_str();
     command->add_option("--html", o->html,
                         "Write a self-contained HTML report of the run here (as tpsim report "

@@ -85,6 +85,12 @@ std::string_view metric_name(HeatMetric metric) {
     return kMetricNames[size_t(metric)];
 }
 
+HeatScale parse_heat_scale(std::string_view name) {
+    if (name == "linear") return HeatScale::Linear;
+    if (name == "log") return HeatScale::Log;
+    throw Error(fmt::format("unknown heat-map scale '{}'; use linear or log", name));
+}
+
 HeatMetric parse_heat_metric(std::string_view name) {
     for (size_t i = 0; i < kMetricNames.size(); ++i)
         if (name == kMetricNames[i]) return HeatMetric(i);
@@ -139,7 +145,7 @@ std::array<float, 3> inferno(float t) {
 
 HeatmapFiles write_heatmap(const std::filesystem::path& png_path,
                            const timing::WorkItemCosts& costs, uint32_t width, uint32_t height,
-                           HeatMetric metric) {
+                           HeatMetric metric, HeatScale scale) {
     check_heatmap_path(png_path);
     if (width == 0 || height == 0)
         throw Error(fmt::format("cannot write heat map '{}': the image has no pixels ({}x{})",
@@ -156,11 +162,18 @@ HeatmapFiles write_heatmap(const std::filesystem::path& png_path,
 
     const auto [lowest, highest] = std::minmax_element(values.begin(), values.end());
     const double low = *lowest, range = *highest - *lowest;
-    const auto colour = [&](double v) { return inferno(range > 0 ? float((v - low) / range) : 0); };
+    // Position on the colour bar, 0 at the minimum, 1 at the maximum.
+    const bool log_scale = scale == HeatScale::Log;
+    const auto position = [&](double v) {
+        if (range <= 0) return 0.0f;
+        return float(log_scale ? std::log1p(v - low) / std::log1p(range) : (v - low) / range);
+    };
+    const auto colour = [&](double v) { return inferno(position(v)); };
 
     namespace algo = OIIO::ImageBufAlgo;
     const std::string low_text = grouped(low), high_text = grouped(*highest);
-    const std::string label(kMetricLabels[size_t(metric)]);
+    const std::string label =
+        std::string(kMetricLabels[size_t(metric)]) + (log_scale ? " (log scale)" : "");
     const auto text_width = [](const std::string& text) {
         const OIIO::ROI size = algo::text_size(text, kFontSize, kFont);
         return size.defined() ? size.width() : 0;

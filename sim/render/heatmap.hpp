@@ -21,6 +21,14 @@ std::string_view metric_name(HeatMetric metric);
 /// The metric called `name`; throws tpsim::Error naming the choices for anything else.
 HeatMetric parse_heat_metric(std::string_view name);
 
+/// How values map to colours: evenly from the minimum to the maximum, or by the logarithm of
+/// their distance from the minimum (costs per pixel are heavy-tailed: a few grazing rays would
+/// otherwise darken the rest).
+enum class HeatScale { Linear, Log };
+
+/// The scale called "linear" or "log"; throws tpsim::Error naming the choices otherwise.
+HeatScale parse_heat_scale(std::string_view name);
+
 /// Throws tpsim::Error unless a heat map can be written at `path`: a .png name in an existing
 /// directory. Called before a render so a long run cannot end in a bad path.
 void check_heatmap_path(const std::filesystem::path& path);
@@ -42,11 +50,11 @@ struct HeatmapFiles {
 };
 
 /// Writes the heat map of `metric` to `png_path` (false colour from the minimum to the maximum
-/// pixel value, magnified for small images, a legend bar with the minimum, the maximum and the
-/// metric's name below it) and the raw per-pixel values as one float channel to the same stem
-/// with .exr (exact up to 2^24). Throws tpsim::Error for a bad path or a failed write.
+/// pixel value on `scale`, magnified for small images, a legend bar with the minimum, the
+/// maximum and the metric's name below it) and the raw per-pixel values as one float channel to the
+/// same stem with .exr (exact up to 2^24). Throws tpsim::Error for a bad path or a failed write.
 HeatmapFiles write_heatmap(const std::filesystem::path& png_path,
                            const timing::WorkItemCosts& costs, uint32_t width, uint32_t height,
-                           HeatMetric metric);
+                           HeatMetric metric, HeatScale scale = HeatScale::Linear);
 
 }  // namespace tpsim::render

@@ -142,6 +142,30 @@ TEST_CASE("heat map: the PNG maps the values to inferno with a legend below", "[
     CHECK(wide.height > png.height);
 }
 
+TEST_CASE("heat map: the log scale spreads heavy-tailed costs", "[heatmap]") {
+    constexpr uint32_t w = 100, h = 4;
+    timing::WorkItemCosts costs;
+    for (uint32_t i = 0; i < w * h; ++i)  // 100 everywhere, one pixel per row 100x that
+        costs.items.push_back({i % w == 99 ? 10'000u : 100u + i % w, 0, 0});
+    const auto linear =
+        render::write_heatmap(scratch("tail_linear.png"), costs, w, h, render::HeatMetric::Cycles);
+    const auto log = render::write_heatmap(scratch("tail_log.png"), costs, w, h,
+                                           render::HeatMetric::Cycles, render::HeatScale::Log);
+    const Pixels a = read(linear.png), b = read(log.png);
+    const auto pixel = [](const Pixels& png, int x) {
+        return std::array<float, 3>{png.at(x, 0, 0), png.at(x, 0, 1), png.at(x, 0, 2)};
+    };
+    // Pixel 50 (value 150) is 50 above the minimum in a range of 9,900.
+    CHECK(pixel(a, 4 * 50) == as_bytes(render::inferno(50.f / 9900.f)));
+    CHECK(pixel(b, 4 * 50) ==
+          as_bytes(render::inferno(float(std::log1p(50.0) / std::log1p(9900.0)))));
+    CHECK(pixel(b, 0) == as_bytes(render::inferno(0)));       // the minimum stays black
+    CHECK(pixel(b, 4 * 99) == as_bytes(render::inferno(1)));  // the maximum stays yellow
+    CHECK(render::parse_heat_scale("log") == render::HeatScale::Log);
+    CHECK_THROWS_WITH(render::parse_heat_scale("sqrt"),
+                      Catch::Contains("unknown heat-map scale 'sqrt'; use linear or log"));
+}
+
 TEST_CASE("heat map: the same costs give the same bytes", "[heatmap]") {
     const timing::WorkItemCosts costs = pattern(64 * 64);
     const auto read_bytes = [](const std::filesystem::path& path) {
