@@ -25,6 +25,14 @@ std::string_view engine_name(Engine engine) {
     return "";
 }
 
+/// A path as a person reads it: relative to the working directory when it lies below it.
+std::string display_path(const std::filesystem::path& path) {
+    std::error_code ec;
+    const std::filesystem::path relative = std::filesystem::proximate(path, ec);
+    return !ec && !relative.empty() && *relative.begin() != ".." ? relative.string()
+                                                                 : path.string();
+}
+
 /// "12.3 KiB": bytes in the largest binary unit that keeps the number >= 1.
 std::string bytes_text(double bytes) {
     const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB"};
@@ -205,7 +213,8 @@ void print_summary(const RenderOptions& options, const RenderResult& r, std::ost
     fmt::print(out, "scene    {} ({} triangles, {} lights, {} materials), {}x{} pixels, {} spp\n",
                options.scene.string(), r.scene.triangles.size(), r.scene.lights.size(),
                r.scene.materials.size(), r.scene.width, r.scene.height, r.scene.samples_per_pixel);
-    fmt::print(out, "kernel   {} on {} ({} TMs x {} TPs = {} threads)\n", options.kernel.string(),
+    fmt::print(out, "kernel   {} on {} ({} TMs x {} TPs = {} threads)\n",
+               display_path(options.kernel),
                options.engine == Engine::native   ? "the native twin"
                : options.engine == Engine::timing ? "the cycle-level chip model"
                                                   : "the functional simulator",
