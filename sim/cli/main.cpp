@@ -1,6 +1,7 @@
 // The tpsim command: parses the command line and hands the chosen subcommand to the libraries.
 // To add a subcommand, write an add_<name>_command() (commands.hpp) and list it below.
 #include <exception>
+#include <string>
 
 #include <fmt/format.h>
 
@@ -17,8 +18,14 @@ int main(int argc, char** argv) {
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        // CLI11 prints the problem (or the help); a usage error exits 2 like every other error.
-        return app.exit(e) == 0 ? 0 : 2;
+        // --help prints the help through CLI11. A usage error is one line like every other
+        // error, naming the help of the subcommand it was made in.
+        if (e.get_exit_code() == 0) return app.exit(e);
+        std::string help = "tpsim --help";
+        for (const tpsim::cli::Command& command : commands)
+            if (command.parser->parsed()) help = "tpsim " + command.parser->get_name() + " --help";
+        fmt::print(stderr, "tpsim: {} (see {})\n", e.what(), help);
+        return 2;
     }
     if (app.get_subcommands().empty()) {
         fmt::print(stderr,
