@@ -1,6 +1,10 @@
 // The tpsim command: parses the command line and hands the chosen subcommand to the libraries.
 // To add a subcommand, write an add_<name>_command() (commands.hpp) and list it below.
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <exception>
+#include <iostream>
 #include <string>
 
 #include <fmt/format.h>
@@ -32,13 +36,23 @@ int main(int argc, char** argv) {
                    "tpsim: give a subcommand: render, exec, compare or report (tpsim --help)\n");
         return 2;
     }
+    int status = 0;
     try {
         for (const tpsim::cli::Command& command : commands)
-            if (command.parser->parsed()) return command.run();
+            if (command.parser->parsed()) status = command.run();
     } catch (const std::exception& e) {
         // Every tpsim error is one line saying what, where and how to fix it.
         fmt::print(stderr, "tpsim: {}\n", e.what());
         return 2;
     }
-    return 0;
+    // A report lost on a full disk or a closed pipe is an error, not a success.
+    std::cout.flush();
+    if (!std::cout || std::fflush(stdout) != 0 || std::ferror(stdout)) {
+        fmt::print(stderr,
+                   "tpsim: cannot write the report to standard output ({}); free space "
+                   "on its device or redirect it elsewhere\n",
+                   std::strerror(errno));
+        return 2;
+    }
+    return status;
 }
