@@ -10,6 +10,7 @@
 
 #include "sim/analysis/page_assets.hpp"
 #include "sim/core/error.hpp"
+#include "sim/stats/thousands.hpp"
 
 namespace tpsim::analysis {
 namespace {
@@ -55,13 +56,7 @@ std::string short_number(double value) {
 std::string readable(double value) {
     const std::string text = format_number(value);
     if (text.find_first_not_of("-0123456789") != std::string::npos) return text;
-    const size_t sign = text[0] == '-' ? 1 : 0, digits = text.size() - sign;
-    std::string grouped = text.substr(0, sign);
-    for (size_t i = 0; i < digits; ++i) {
-        if (i > 0 && (digits - i) % 3 == 0) grouped += ',';
-        grouped += text[sign + i];
-    }
-    return grouped;
+    return stats::with_thousands(text);
 }
 
 /// One chart for the JSON blob; report_page.js draws it with Chart.js.

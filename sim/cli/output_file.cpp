@@ -5,17 +5,13 @@
 
 #include "commands.hpp"
 #include "sim/core/error.hpp"
+#include "sim/core/output_directory.hpp"
 
 namespace tpsim::cli {
 
 void check_output_path(const std::filesystem::path& path, const std::string& what) {
-    const std::filesystem::path directory =
-        path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
-    std::error_code ec;
-    if (!std::filesystem::is_directory(directory, ec))
-        throw Error(fmt::format("cannot write {} to '{}': directory '{}' does not exist", what,
-                                path.string(), directory.string()));
-    if (std::filesystem::is_directory(path, ec))
+    require_output_directory(path, fmt::format("cannot write {} to '{}'", what, path.string()));
+    if (std::error_code ec; std::filesystem::is_directory(path, ec))
         throw Error(fmt::format("cannot write {} to '{}': it is a directory; give a file name",
                                 what, path.string()));
 }

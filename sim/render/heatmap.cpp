@@ -10,6 +10,8 @@
 #include <fmt/format.h>
 
 #include "sim/core/error.hpp"
+#include "sim/core/output_directory.hpp"
+#include "sim/stats/thousands.hpp"
 
 namespace tpsim::render {
 namespace {
@@ -33,13 +35,7 @@ uint64_t metric_of(const timing::WorkItemCounters& item, HeatMetric metric) {
 
 /// "1,234,567": legend values are counts.
 std::string grouped(double value) {
-    const std::string digits = fmt::format("{:.0f}", value);
-    std::string text;
-    for (size_t i = 0; i < digits.size(); ++i) {
-        if (i > 0 && (digits.size() - i) % 3 == 0) text += ',';
-        text += digits[i];
-    }
-    return text;
+    return stats::with_thousands(fmt::format("{:.0f}", value));
 }
 
 // Layout of the PNG, in pixels.
@@ -106,11 +102,7 @@ void check_heatmap_path(const std::filesystem::path& path) {
         throw Error(fmt::format("cannot write heat map '{}': it is a PNG (its float EXR goes "
                                 "beside it); give a name ending in .png",
                                 path.string()));
-    const std::filesystem::path directory =
-        path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
-    if (std::error_code ec; !std::filesystem::is_directory(directory, ec))
-        throw Error(fmt::format("cannot write heat map '{}': directory '{}' does not exist",
-                                path.string(), directory.string()));
+    require_output_directory(path, fmt::format("cannot write heat map '{}'", path.string()));
 }
 
 std::vector<double> heat_values(const timing::WorkItemCosts& costs, uint32_t width, uint32_t height,

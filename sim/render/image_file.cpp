@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "sim/core/error.hpp"
+#include "sim/core/output_directory.hpp"
 
 namespace tpsim::render {
 namespace {
@@ -41,11 +42,7 @@ void check_image_path(const std::filesystem::path& path) {
                 ? fmt::format("no image format has the extension '{}'", path.extension().string())
                 : std::string("the name has no image extension")));
     }
-    const std::filesystem::path directory =
-        path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
-    if (std::error_code ec; !std::filesystem::is_directory(directory, ec))
-        throw Error(fmt::format("cannot write image '{}': directory '{}' does not exist",
-                                path.string(), directory.string()));
+    require_output_directory(path, fmt::format("cannot write image '{}'", path.string()));
 }
 
 void write_image(const std::filesystem::path& path, std::span<const float> rgb, uint32_t width,

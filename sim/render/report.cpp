@@ -7,6 +7,7 @@
 #include <fmt/ostream.h>
 
 #include "profile.hpp"
+#include "sim/stats/thousands.hpp"
 #include "timing_run.hpp"
 
 namespace tpsim::render {
@@ -46,13 +47,7 @@ std::string bytes_text(double bytes) {
 
 /// "12,345,678": a count with thousands separators.
 std::string count_text(double count) {
-    const std::string digits = fmt::format("{}", uint64_t(count));
-    std::string grouped;
-    for (size_t i = 0; i < digits.size(); ++i) {
-        if (i > 0 && (digits.size() - i) % 3 == 0) grouped += ',';
-        grouped += digits[i];
-    }
-    return grouped;
+    return stats::with_thousands(fmt::format("{}", uint64_t(count)));
 }
 
 std::string percent_text(double numerator, double denominator) {
