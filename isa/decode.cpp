@@ -1,6 +1,6 @@
 // Decoder: a linear scan of the instruction table (it runs once per word of the text segment,
 // never in the execute loop), then field extraction by format.
-#include "isa.hpp"
+#include "isa/isa.hpp"
 
 namespace tpsim::isa {
 namespace {

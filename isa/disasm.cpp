@@ -3,8 +3,8 @@
 #include <array>
 #include <string>
 
-#include "csr.hpp"
-#include "isa.hpp"
+#include "isa/csr.hpp"
+#include "isa/isa.hpp"
 
 namespace tpsim::isa {
 namespace {

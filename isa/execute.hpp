@@ -3,9 +3,9 @@
 #pragma once
 #include <cstdint>
 
-#include "csr.hpp"
-#include "fpu.hpp"
-#include "hart.hpp"
+#include "isa/csr.hpp"
+#include "isa/fpu.hpp"
+#include "isa/hart.hpp"
 
 namespace tpsim::isa {
 namespace detail {
@@ -169,7 +169,7 @@ template <class Env> inline void execute(const Decoded& d, Hart& h, Env& env) {
         __VA_ARGS__;                                                                               \
         break;                                                                                     \
     }
-#include "instructions.def"
+#include "isa/instructions.def"
 #undef TPSIM_INSN
     case Op::Illegal:
     case Op::Count:

@@ -5,7 +5,7 @@
 //
 // Compiled with -frounding-math; in addition every operation is fenced by empty volatile asm so
 // the compiler can neither fold it nor move it across the MXCSR writes and reads.
-#include "fpu.hpp"
+#include "isa/fpu.hpp"
 
 #include <cmath>
 #include <type_traits>

@@ -1,6 +1,6 @@
 // Architectural state of one hardware thread, and the contract of execute().
 #pragma once
-#include "isa.hpp"
+#include "isa/isa.hpp"
 
 namespace tpsim::isa {
 

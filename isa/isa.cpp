@@ -1,10 +1,10 @@
 // The static instruction table (expanded from instructions.def) and small accessors.
-#include "isa.hpp"
+#include "isa/isa.hpp"
 
 #include <bit>
 #include <iterator>
 
-#include "hart.hpp"
+#include "isa/hart.hpp"
 
 namespace tpsim::isa {
 
@@ -12,7 +12,7 @@ const InsnInfo& info(Op op) {
     static constexpr InsnInfo kTable[] = {
 #define TPSIM_INSN(name, mnemonic, match, mask, format, fu, operands, ...)                         \
     {mnemonic, match, mask, format, fu, operand_info(operands)},
-#include "instructions.def"
+#include "isa/instructions.def"
 #undef TPSIM_INSN
         {"<illegal>", 0, 0, Format::System, FuClass::System, {}},
     };

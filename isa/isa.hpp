@@ -11,7 +11,7 @@ namespace tpsim::isa {
 /// One enumerator per instruction in instructions.def, plus Illegal for undecodable words.
 enum class Op : uint16_t {
 #define TPSIM_INSN(name, ...) name,
-#include "instructions.def"
+#include "isa/instructions.def"
 #undef TPSIM_INSN
     Illegal,
     Count

@@ -10,9 +10,9 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
-#include "commands.hpp"
 #include "sim/analysis/compare.hpp"
 #include "sim/analysis/html_report.hpp"
+#include "sim/cli/commands.hpp"
 #include "sim/core/error.hpp"
 
 namespace tpsim::cli {

@@ -2,7 +2,7 @@
 #include <memory>
 #include <string>
 
-#include "commands.hpp"
+#include "sim/cli/commands.hpp"
 #include "sim/core/elf_loader.hpp"
 #include "sim/core/machine.hpp"
 

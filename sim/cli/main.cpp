@@ -9,7 +9,7 @@
 
 #include <fmt/format.h>
 
-#include "commands.hpp"
+#include "sim/cli/commands.hpp"
 
 int main(int argc, char** argv) {
     CLI::App app{"tpsim: a cycle-counting simulator of TRaX ray-tracing hardware"};

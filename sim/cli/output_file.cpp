@@ -3,7 +3,7 @@
 
 #include <fmt/format.h>
 
-#include "commands.hpp"
+#include "sim/cli/commands.hpp"
 #include "sim/core/error.hpp"
 #include "sim/core/output_directory.hpp"
 

@@ -11,9 +11,9 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
-#include "commands.hpp"
 #include "sim/analysis/html_report.hpp"
 #include "sim/analysis/stats_file.hpp"
+#include "sim/cli/commands.hpp"
 #include "sim/core/error.hpp"
 #include "sim/render/heatmap.hpp"
 #include "sim/render/image_file.hpp"

@@ -2,8 +2,8 @@
 #include <memory>
 #include <string>
 
-#include "commands.hpp"
 #include "sim/analysis/html_report.hpp"
+#include "sim/cli/commands.hpp"
 
 namespace tpsim::cli {
 namespace {

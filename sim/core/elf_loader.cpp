@@ -1,4 +1,4 @@
-#include "elf_loader.hpp"
+#include "sim/core/elf_loader.hpp"
 
 #include <algorithm>
 #include <cstddef>
@@ -18,8 +18,8 @@
 #include <gelf.h>
 #include <libelf.h>
 
-#include "error.hpp"
 #include "kernel/memory_map.hpp"
+#include "sim/core/error.hpp"
 
 namespace tpsim::core {
 

@@ -1,4 +1,4 @@
-#include "fault.hpp"
+#include "sim/core/fault.hpp"
 
 namespace tpsim::core {
 

@@ -4,7 +4,7 @@
 #include <string>
 #include <string_view>
 
-#include "error.hpp"
+#include "sim/core/error.hpp"
 
 namespace tpsim::core {
 

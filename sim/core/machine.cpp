@@ -1,13 +1,13 @@
-#include "machine.hpp"
+#include "sim/core/machine.hpp"
 
 #include <algorithm>
 #include <bit>
 
 #include <fmt/format.h>
 
-#include "error.hpp"
 #include "isa/csr.hpp"
-#include "thread_env.hpp"
+#include "sim/core/error.hpp"
+#include "sim/core/thread_env.hpp"
 
 namespace tpsim::core {
 

@@ -5,10 +5,10 @@
 #include <span>
 #include <vector>
 
-#include "elf_loader.hpp"
-#include "fault.hpp"
 #include "isa/hart.hpp"
-#include "memory.hpp"
+#include "sim/core/elf_loader.hpp"
+#include "sim/core/fault.hpp"
+#include "sim/core/memory.hpp"
 
 namespace tpsim::core {
 

@@ -1,9 +1,9 @@
-#include "memory.hpp"
+#include "sim/core/memory.hpp"
 
 #include <fmt/format.h>
 
-#include "error.hpp"
-#include "fault.hpp"
+#include "sim/core/error.hpp"
+#include "sim/core/fault.hpp"
 
 namespace tpsim::core {
 namespace {

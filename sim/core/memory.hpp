@@ -7,8 +7,8 @@
 #include <span>
 #include <vector>
 
-#include "elf_loader.hpp"
 #include "kernel/memory_map.hpp"
+#include "sim/core/elf_loader.hpp"
 
 namespace tpsim::core {
 

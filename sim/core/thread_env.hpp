@@ -9,7 +9,7 @@
 
 #include "isa/execute.hpp"
 #include "kernel/memory_map.hpp"
-#include "machine.hpp"
+#include "sim/core/machine.hpp"
 
 namespace tpsim::core {
 

@@ -1,4 +1,4 @@
-#include "memory_image.hpp"
+#include "sim/image/memory_image.hpp"
 
 #include <algorithm>
 #include <cmath>

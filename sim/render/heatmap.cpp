@@ -1,4 +1,4 @@
-#include "heatmap.hpp"
+#include "sim/render/heatmap.hpp"
 
 #include <algorithm>
 #include <cctype>

@@ -1,4 +1,4 @@
-#include "image_file.hpp"
+#include "sim/render/image_file.hpp"
 
 #include <algorithm>
 #include <cmath>

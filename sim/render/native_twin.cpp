@@ -1,4 +1,4 @@
-#include "native_twin.hpp"
+#include "sim/render/native_twin.hpp"
 
 #include <dlfcn.h>
 #include <signal.h>

@@ -1,4 +1,4 @@
-#include "profile.hpp"
+#include "sim/render/profile.hpp"
 
 #include <algorithm>
 #include <cctype>

@@ -1,17 +1,17 @@
-#include "render.hpp"
+#include "sim/render/render.hpp"
 
 #include <chrono>
 #include <cstring>
 
 #include <fmt/format.h>
 
-#include "native_twin.hpp"
-#include "profile.hpp"
 #include "sim/core/error.hpp"
 #include "sim/core/machine.hpp"
+#include "sim/render/native_twin.hpp"
+#include "sim/render/profile.hpp"
+#include "sim/render/timing_run.hpp"
 #include "sim/scene/load_scene.hpp"
 #include "sim/timing/machine_source.hpp"
-#include "timing_run.hpp"
 
 namespace tpsim::render {
 namespace {

@@ -1,4 +1,4 @@
-#include "report.hpp"
+#include "sim/render/report.hpp"
 
 #include <algorithm>
 #include <ostream>
@@ -6,9 +6,9 @@
 #include <fmt/format.h>
 #include <fmt/ostream.h>
 
-#include "profile.hpp"
+#include "sim/render/profile.hpp"
+#include "sim/render/timing_run.hpp"
 #include "sim/stats/thousands.hpp"
-#include "timing_run.hpp"
 
 namespace tpsim::render {
 

@@ -8,7 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "render.hpp"
+#include "sim/render/render.hpp"
 #include "sim/stats/registry.hpp"
 
 namespace tpsim::render {

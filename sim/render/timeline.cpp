@@ -1,4 +1,4 @@
-#include "timeline.hpp"
+#include "sim/render/timeline.hpp"
 
 #include <algorithm>
 #include <limits>

@@ -1,4 +1,4 @@
-#include "timing_run.hpp"
+#include "sim/render/timing_run.hpp"
 
 #include <algorithm>
 #include <cstring>

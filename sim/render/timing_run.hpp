@@ -6,12 +6,12 @@
 #include <memory>
 
 #include "kernel/memory_map.hpp"
-#include "render.hpp"
 #include "sim/core/machine.hpp"
 #include "sim/image/memory_image.hpp"
+#include "sim/render/render.hpp"
+#include "sim/render/timeline.hpp"
 #include "sim/timing/chip.hpp"
 #include "sim/timing/machine_source.hpp"
-#include "timeline.hpp"
 
 namespace tpsim::render {
 

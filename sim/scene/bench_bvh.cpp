@@ -6,8 +6,8 @@
 
 #include <fmt/format.h>
 
-#include "bvh.hpp"
-#include "load_scene.hpp"
+#include "sim/scene/bvh.hpp"
+#include "sim/scene/load_scene.hpp"
 
 int main(int argc, char** argv) {
     using namespace tpsim::scene;

@@ -1,4 +1,4 @@
-#include "bvh.hpp"
+#include "sim/scene/bvh.hpp"
 
 #include <algorithm>
 #include <chrono>

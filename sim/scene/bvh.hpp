@@ -9,7 +9,7 @@
 
 #include <glm/glm.hpp>
 
-#include "scene.hpp"
+#include "sim/scene/scene.hpp"
 
 namespace tpsim::scene {
 

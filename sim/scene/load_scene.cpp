@@ -1,4 +1,4 @@
-#include "load_scene.hpp"
+#include "sim/scene/load_scene.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,8 +10,8 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <toml++/toml.h>
 
-#include "mesh_import.hpp"
-#include "procedural.hpp"
+#include "sim/scene/mesh_import.hpp"
+#include "sim/scene/procedural.hpp"
 
 namespace tpsim::scene {
 

@@ -2,17 +2,17 @@
 #pragma once
 #include <filesystem>
 #include <span>
-#include <stdexcept>
 
-#include "bvh.hpp"
-#include "scene.hpp"
+#include "sim/core/error.hpp"
+#include "sim/scene/bvh.hpp"
+#include "sim/scene/scene.hpp"
 
 namespace tpsim::scene {
 
 /// Every problem with a scene or mesh file, as one line: "file:line:column: what, allowed range".
-class SceneError : public std::runtime_error {
+class SceneError : public Error {
 public:
-    using std::runtime_error::runtime_error;
+    using Error::Error;
 };
 
 /// A `.toml` path is read as a scene file; anything assimp reads is loaded as a bare mesh with

@@ -1,4 +1,4 @@
-#include "mesh_import.hpp"
+#include "sim/scene/mesh_import.hpp"
 
 #include <algorithm>
 #include <cctype>

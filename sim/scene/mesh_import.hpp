@@ -3,7 +3,7 @@
 #include <filesystem>
 #include <vector>
 
-#include "scene.hpp"
+#include "sim/scene/scene.hpp"
 
 namespace tpsim::scene {
 

@@ -1,4 +1,4 @@
-#include "procedural.hpp"
+#include "sim/scene/procedural.hpp"
 
 #include <cmath>
 #include <numbers>

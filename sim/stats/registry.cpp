@@ -1,4 +1,4 @@
-#include "registry.hpp"
+#include "sim/stats/registry.hpp"
 
 #include <fmt/format.h>
 

@@ -1,4 +1,4 @@
-#include "cache.hpp"
+#include "sim/timing/cache.hpp"
 
 #include <fmt/format.h>
 

@@ -8,10 +8,10 @@
 // % banks. Fills do not occupy a bank. Data values are never stored: the functional core owns
 // them.
 #pragma once
-#include "stats/registry.hpp"
-#include "timing/bits.hpp"
-#include "timing/config.hpp"
-#include "timing/memory.hpp"
+#include "sim/stats/registry.hpp"
+#include "sim/timing/bits.hpp"
+#include "sim/timing/config.hpp"
+#include "sim/timing/memory.hpp"
 
 #include <bit>
 #include <cstdint>

@@ -1,8 +1,8 @@
-#include "chip.hpp"
+#include "sim/timing/chip.hpp"
 
 #include "kernel/memory_map.hpp"
-#include "timing/bits.hpp"
-#include "timing/machine_source.hpp"
+#include "sim/timing/bits.hpp"
+#include "sim/timing/machine_source.hpp"
 
 #include <fmt/format.h>
 

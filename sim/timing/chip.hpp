@@ -10,13 +10,13 @@
 #pragma once
 #include "isa/isa.hpp"
 #include "sim/core/machine.hpp"
-#include "stats/registry.hpp"
-#include "timing/attribution.hpp"
-#include "timing/cache.hpp"
-#include "timing/config.hpp"
-#include "timing/dram.hpp"
-#include "timing/fu_pool.hpp"
-#include "timing/global_registers.hpp"
+#include "sim/stats/registry.hpp"
+#include "sim/timing/attribution.hpp"
+#include "sim/timing/cache.hpp"
+#include "sim/timing/config.hpp"
+#include "sim/timing/dram.hpp"
+#include "sim/timing/fu_pool.hpp"
+#include "sim/timing/global_registers.hpp"
 
 #include <array>
 #include <cstdint>

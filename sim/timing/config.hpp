@@ -3,17 +3,18 @@
 // overridable field by field, validated with messages naming the key and its allowed range.
 #pragma once
 #include <cstdint>
-#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "sim/core/error.hpp"
 
 namespace tpsim::timing {
 
 /// Thrown for any configuration problem; the message names the file:line or override, the key
 /// and the allowed range.
-struct ConfigError : std::runtime_error {
-    using std::runtime_error::runtime_error;
+struct ConfigError : Error {
+    using Error::Error;
 };
 
 /// [chip] The shape of the whole chip.

@@ -1,4 +1,4 @@
-#include "dram.hpp"
+#include "sim/timing/dram.hpp"
 
 #include <fmt/format.h>
 

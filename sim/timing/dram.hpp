@@ -10,9 +10,9 @@
 // Not modelled: refresh, ranks, bank groups, tFAW, power-down, command-bus slots beyond one
 // command per channel per cycle.
 #pragma once
-#include "stats/registry.hpp"
-#include "timing/config.hpp"
-#include "timing/memory.hpp"
+#include "sim/stats/registry.hpp"
+#include "sim/timing/config.hpp"
+#include "sim/timing/memory.hpp"
 
 #include <array>
 #include <cstdint>

@@ -1,4 +1,4 @@
-#include "fu_pool.hpp"
+#include "sim/timing/fu_pool.hpp"
 
 #include <fmt/format.h>
 

@@ -3,9 +3,9 @@
 // (requesters - 1) grants behind the others.
 #pragma once
 #include "isa/isa.hpp"
-#include "stats/registry.hpp"
-#include "timing/bits.hpp"
-#include "timing/config.hpp"
+#include "sim/stats/registry.hpp"
+#include "sim/timing/bits.hpp"
+#include "sim/timing/config.hpp"
 
 #include <algorithm>
 #include <bit>

@@ -1,4 +1,4 @@
-#include "global_registers.hpp"
+#include "sim/timing/global_registers.hpp"
 
 #include <fmt/format.h>
 

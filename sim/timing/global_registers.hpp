@@ -4,8 +4,8 @@
 // does not depend on which TM the host simulated first. Only timing lives here: the value each
 // thread receives is computed by the functional core.
 #pragma once
-#include "stats/registry.hpp"
-#include "timing/config.hpp"
+#include "sim/stats/registry.hpp"
+#include "sim/timing/config.hpp"
 
 #include <cstdint>
 #include <functional>

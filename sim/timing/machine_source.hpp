@@ -4,7 +4,7 @@
 #pragma once
 #include "sim/core/machine.hpp"
 #include "sim/core/thread_env.hpp"
-#include "timing/chip.hpp"
+#include "sim/timing/chip.hpp"
 
 #include <array>
 #include <cstring>

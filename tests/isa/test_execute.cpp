@@ -2,7 +2,7 @@
 // Expected values come from the RISC-V unprivileged spec (chapters 2, 7, 9) by hand.
 #include <catch2/catch.hpp>
 
-#include "test_support.hpp"
+#include "tests/isa/test_support.hpp"
 
 using namespace tpsim::isa;
 using namespace tpsim::isa::test;

@@ -8,7 +8,7 @@
 #include <limits>
 #include <random>
 
-#include "test_support.hpp"
+#include "tests/isa/test_support.hpp"
 
 using namespace tpsim::isa;
 using namespace tpsim::isa::test;

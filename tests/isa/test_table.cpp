@@ -7,7 +7,7 @@
 #include <regex>
 #include <sstream>
 
-#include "test_support.hpp"
+#include "tests/isa/test_support.hpp"
 
 using namespace tpsim::isa;
 using namespace tpsim::isa::test;

@@ -5,9 +5,9 @@
 
 #include <catch2/catch.hpp>
 
-#include "bvh.hpp"
-#include "load_scene.hpp"
-#include "procedural.hpp"
+#include "sim/scene/bvh.hpp"
+#include "sim/scene/load_scene.hpp"
+#include "sim/scene/procedural.hpp"
 
 using namespace tpsim::scene;
 

@@ -1,8 +1,8 @@
 #include <catch2/catch.hpp>
 
-#include "load_scene.hpp"
-#include "mesh_import.hpp"
-#include "scene_test_util.hpp"
+#include "sim/scene/load_scene.hpp"
+#include "sim/scene/mesh_import.hpp"
+#include "tests/scene/scene_test_util.hpp"
 
 using namespace tpsim::scene;
 using tpsim::scene::testing::write_file;

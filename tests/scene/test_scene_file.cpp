@@ -2,8 +2,8 @@
 
 #include <catch2/catch.hpp>
 
-#include "load_scene.hpp"
-#include "scene_test_util.hpp"
+#include "sim/scene/load_scene.hpp"
+#include "tests/scene/scene_test_util.hpp"
 
 using namespace tpsim::scene;
 using tpsim::scene::testing::write_file;

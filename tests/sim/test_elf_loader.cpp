@@ -7,7 +7,7 @@
 #include "sim/core/elf_loader.hpp"
 #include "sim/core/error.hpp"
 #include "sim/core/machine.hpp"
-#include "test_support.hpp"
+#include "tests/sim/test_support.hpp"
 
 using namespace tpsim;
 using namespace tpsim::core;

@@ -10,7 +10,7 @@
 #include "kernel/memory_map.hpp"
 #include "sim/core/error.hpp"
 #include "sim/core/machine.hpp"
-#include "test_support.hpp"
+#include "tests/sim/test_support.hpp"
 
 using namespace tpsim;
 using namespace tpsim::core;

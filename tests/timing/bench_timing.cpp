@@ -8,7 +8,7 @@
 #include "sim/render/timing_run.hpp"  // chip_layout() only (inline): no image-file libraries
 #include "sim/scene/bvh.hpp"
 #include "sim/scene/load_scene.hpp"
-#include "timing/machine_source.hpp"
+#include "sim/timing/machine_source.hpp"
 
 #include <fmt/format.h>
 

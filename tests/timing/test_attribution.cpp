@@ -6,7 +6,7 @@
 #include "sim/render/timing_run.hpp"
 #include "sim/scene/bvh.hpp"
 #include "sim/scene/load_scene.hpp"
-#include "timing/machine_source.hpp"
+#include "sim/timing/machine_source.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -1,4 +1,4 @@
-#include "timing/bits.hpp"
+#include "sim/timing/bits.hpp"
 
 #include <catch2/catch.hpp>
 

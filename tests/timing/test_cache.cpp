@@ -1,4 +1,4 @@
-#include "timing/cache.hpp"
+#include "sim/timing/cache.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -1,8 +1,8 @@
-#include "timing/chip.hpp"
+#include "sim/timing/chip.hpp"
 
 #include <catch2/catch.hpp>
 
-#include "documented_stats.hpp"
+#include "tests/timing/documented_stats.hpp"
 
 #include <algorithm>
 #include <deque>

@@ -1,4 +1,4 @@
-#include "timing/config.hpp"
+#include "sim/timing/config.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -1,5 +1,5 @@
-#include "timing/dram.hpp"
-#include "timing/global_registers.hpp"
+#include "sim/timing/dram.hpp"
+#include "sim/timing/global_registers.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -1,4 +1,4 @@
-#include "timing/fu_pool.hpp"
+#include "sim/timing/fu_pool.hpp"
 
 #include <catch2/catch.hpp>
 

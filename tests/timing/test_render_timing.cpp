@@ -7,12 +7,12 @@
 #include "sim/render/timing_run.hpp"
 #include "sim/scene/bvh.hpp"
 #include "sim/scene/load_scene.hpp"
-#include "timing/config.hpp"
-#include "timing/machine_source.hpp"
+#include "sim/timing/config.hpp"
+#include "sim/timing/machine_source.hpp"
 
 #include <catch2/catch.hpp>
 
-#include "documented_stats.hpp"
+#include "tests/timing/documented_stats.hpp"
 
 #include <unistd.h>
 

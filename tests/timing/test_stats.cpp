@@ -1,4 +1,4 @@
-#include "stats/registry.hpp"
+#include "sim/stats/registry.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -3,7 +3,7 @@
 // the configuration implies. Latencies come from two builds of one program that differ only
 // by 64 extra dependent steps, so the cycle difference is 64 x the per-step latency.
 #include "sim/core/elf_loader.hpp"
-#include "timing/machine_source.hpp"
+#include "sim/timing/machine_source.hpp"
 
 #include <catch2/catch.hpp>
 
