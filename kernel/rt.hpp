@@ -48,7 +48,6 @@ inline bool is_nan(float x) {
 struct ShearedRay {
     int kx, ky, kz;
     float ox, oy, oz;
-    float dx, dy, dz;  ///< the direction on the permuted axes
     float sx, sy, sz;
 };
 
@@ -64,11 +63,8 @@ inline ShearedRay shear(Vec3 origin, Vec3 dir) {
         r.kx = r.ky;
         r.ky = k;
     }
-    r.dx = component(dir, r.kx);
-    r.dy = component(dir, r.ky);
-    r.dz = dz;
-    r.sx = r.dx / dz;
-    r.sy = r.dy / dz;
+    r.sx = component(dir, r.kx) / dz;
+    r.sy = component(dir, r.ky) / dz;
     r.sz = 1.0f / dz;
     r.ox = component(origin, r.kx);
     r.oy = component(origin, r.ky);
@@ -134,31 +130,38 @@ constexpr float gamma(int n) {
     if (u + v + w == 0.0f) return false;
 
     // The plane: normal from the edges (on permuted axes: the same products, so the same
-    // numbers up to sign), numerator n.(v0 - o), denominator n.d, and their rounding bounds.
+    // numbers up to sign), numerator n.(v0 - o), denominator n.(sx, sy, 1) (the direction
+    // divided by its z, so the distance along it is t*dz), and their rounding bounds.
     const float e1x = x1 - x0, e1y = y1 - y0, e1z = z1 - z0;
     const float e2x = x2 - x0, e2y = y2 - y0, e2z = z2 - z0;
     const float px = e1y * e2z, qx = e1z * e2y, py = e1z * e2x, qy = e1x * e2z, pz = e1x * e2y,
                 qz = e1y * e2x;
     const float nx = px - qx, ny = py - qy, nz = pz - qz;
-    // |n_i| + gamma(3)/gamma(6) * (|p_i| + |q_i|) <= 2 * (|p_i| + |q_i|): one bound for both.
+    // |n_i| + the error of n_i (gamma(3) * (|p_i| + |q_i|)) <= 2 * (|p_i| + |q_i|).
     const float mx = trax_abs(px) + trax_abs(qx), my = trax_abs(py) + trax_abs(qy),
                 mz = trax_abs(pz) + trax_abs(qz);
     const float ax = x0 - r.ox, ay = y0 - r.oy;
     float num = nx * ax + ny * ay + nz * a_z;
-    float den = nx * r.dx + ny * r.dy + nz * r.dz;
+    // n.d / |dz|, exact up to the rounding of sx and sy: (sx, sy, 1) is d / dz.
+    float den = nx * r.sx + ny * r.sy + nz;
+    if (r.sz < 0.0f) den = -den;
+    // gamma(7): the dot products' rounding, plus one for the subtractions in v0 - o and one
+    // for the rounding of sx and sy.
     const float num_error =
-        2.0f * gamma(6) * (mx * trax_abs(ax) + my * trax_abs(ay) + mz * trax_abs(a_z));
-    const float den_error =
-        2.0f * gamma(6) * (mx * trax_abs(r.dx) + my * trax_abs(r.dy) + mz * trax_abs(r.dz));
+        2.0f * gamma(7) * (mx * trax_abs(ax) + my * trax_abs(ay) + mz * trax_abs(a_z));
+    const float den_error = 2.0f * gamma(7) * (mx * trax_abs(r.sx) + my * trax_abs(r.sy) + mz);
     if (den < 0.0f) {
         num = -num;
         den = -den;
     }
-    if (!(num > num_error && den > den_error && num < t_max * den)) return false;
-    hit.t = num / den;
-    // t's rounding moves o + t*d off the plane by at most (num_error + t*den_error)/|n| plus
-    // the division's own rounding.
-    hit.plane_error = num_error + hit.t * (den_error + gamma(1) * den);
+    // t = num / (den * |dz|); compare before dividing so misses cost no division.
+    const float scaled_num = num * trax_abs(r.sz);
+    if (!(num > num_error && den > den_error && scaled_num < t_max * den)) return false;
+    const float inverse_den = 1.0f / den;
+    hit.t = scaled_num * inverse_den;
+    // t's rounding moves o + t*d off the plane by at most (num_error + t*|dz|*den_error)/|n|
+    // plus the rounding of the scaling, the reciprocal and the product.
+    hit.plane_error = num_error + num * inverse_den * den_error + gamma(3) * num;
     return true;
 }
 
