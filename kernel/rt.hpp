@@ -137,26 +137,28 @@ constexpr float gamma(int n) {
     const float px = e1y * e2z, qx = e1z * e2y, py = e1z * e2x, qy = e1x * e2z, pz = e1x * e2y,
                 qz = e1y * e2x;
     const float nx = px - qx, ny = py - qy, nz = pz - qz;
-    // |n_i| + the error of n_i (gamma(3) * (|p_i| + |q_i|)) <= 2 * (|p_i| + |q_i|).
-    const float mx = trax_abs(px) + trax_abs(qx), my = trax_abs(py) + trax_abs(qy),
-                mz = trax_abs(pz) + trax_abs(qz);
     const float ax = x0 - r.ox, ay = y0 - r.oy;
     float num = nx * ax + ny * ay + nz * a_z;
     // n.d / |dz|, exact up to the rounding of sx and sy: (sx, sy, 1) is d / dz.
     float den = nx * r.sx + ny * r.sy + nz;
     if (r.sz < 0.0f) den = -den;
-    // gamma(7): the dot products' rounding, plus one for the subtractions in v0 - o and one
-    // for the rounding of sx and sy.
-    const float num_error =
-        2.0f * gamma(7) * (mx * trax_abs(ax) + my * trax_abs(ay) + mz * trax_abs(a_z));
-    const float den_error = 2.0f * gamma(7) * (mx * trax_abs(r.sx) + my * trax_abs(r.sy) + mz);
     if (den < 0.0f) {
         num = -num;
         den = -den;
     }
-    // t = num / (den * |dz|); compare before dividing so misses cost no division.
+    // t = num / (den * |dz|); behind the origin or beyond t_max (the commonest rejections,
+    // e.g. a shadow ray's own triangle) before the bounds, and no division for a miss.
     const float scaled_num = num * trax_abs(r.sz);
-    if (!(num > num_error && den > den_error && scaled_num < t_max * den)) return false;
+    if (!(num > 0.0f && scaled_num < t_max * den)) return false;
+    // The signs must be certain. |n_i| + the error of n_i (gamma(3) * (|p_i| + |q_i|)) is at
+    // most 2 * (|p_i| + |q_i|); gamma(7): the dot products' rounding, plus one for the
+    // subtractions in v0 - o and one for the rounding of sx and sy.
+    const float mx = trax_abs(px) + trax_abs(qx), my = trax_abs(py) + trax_abs(qy),
+                mz = trax_abs(pz) + trax_abs(qz);
+    const float num_error =
+        2.0f * gamma(7) * (mx * trax_abs(ax) + my * trax_abs(ay) + mz * trax_abs(a_z));
+    const float den_error = 2.0f * gamma(7) * (mx * trax_abs(r.sx) + my * trax_abs(r.sy) + mz);
+    if (!(num > num_error && den > den_error)) return false;
     const float inverse_den = 1.0f / den;
     hit.t = scaled_num * inverse_den;
     // t's rounding moves o + t*d off the plane by at most (num_error + t*|dz|*den_error)/|n|
