@@ -98,7 +98,7 @@ constexpr float gamma(int n) {
 /// larger than the hit distance (a 1e5 floor seen from 5 mm lost its hits near the camera).
 /// For an axis-aligned plane n has one non-zero component and t is exact. Both dot products
 /// carry a conservative rounding bound in the style of pbrt-v4 sec. 6.8 (Pharr, Jakob and
-/// Humphreys, 4th ed.): each term's error is at most gamma(6) times (|n_i| plus the error of n_i,
+/// Humphreys, 4th ed.): each term's error is at most gamma(7) times (|n_i| plus the error of n_i,
 /// itself at most |e1_j e2_k| + |e1_k e2_j| times gamma(3)) times the term's other factor. A hit
 /// whose numerator or denominator could have the wrong sign is rejected, so t > 0 is certain:
 /// a ray leaving a surface from an origin on the right side of its plane never hits it again.
@@ -359,7 +359,7 @@ struct BvhTraversal {
 /// gamma(7) * sum |b_i v_i| bound grows with the vertices' magnitudes in every direction, so on a
 /// 1e5 floor the rebuilt point moved centimetres along the surface and 1 mm objects cast their
 /// shadows in the wrong place; o + t*d with the certain plane t of intersect() is accurate to a
-/// few ulps of |o| and |t*d| along the surface and its normal error is bounded exactly.
+/// few ulps of |o| and |t*d| along the surface, and its distance from the plane is bounded.
 struct SurfacePoint {
     Vec3 p;
     Vec3 n;              ///< unit face normal, on the side of v0, v1, v2's winding
@@ -371,7 +371,8 @@ inline Vec3 abs(Vec3 a) {
 }
 
 /// The surface point of `hit`, a closest hit of the ray (origin, dir) on the image triangle at
-/// address `tri`. p's components carry at most gamma(2) * (|o_i| + |t*d_i|) of rounding.
+/// address `tri`. p's components carry at most gamma(2) * (|o_i| + |t*d_i|) of rounding
+/// (gamma(3) below also covers the bound's own rounding).
 inline SurfacePoint surface_point(int tri, const Hit& hit, Vec3 origin, Vec3 dir) {
     const Vec3 v0 = load_vec3(tri, kTriangleV0);
     const Vec3 n = cross(load_vec3(tri, kTriangleV1) - v0, load_vec3(tri, kTriangleV2) - v0);

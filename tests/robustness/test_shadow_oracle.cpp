@@ -98,6 +98,12 @@ Mesh imported(const std::filesystem::path& path, float size, glm::vec3 center) {
     return mesh;
 }
 
+std::string number(float x) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", double(x));
+    return text;
+}
+
 struct Case {
     std::string name;
     Mesh mesh;
@@ -109,7 +115,7 @@ struct Case {
 
 /// A 1 mm cube resting on a square floor of side `floor` at y = 0, seen from 5 mm away.
 Case small_on_floor(float floor) {
-    Case c{"1 mm cube on a floor of " + std::to_string(floor), {}, {}, {}, 50.0f, {}, 48};
+    Case c{"1 mm cube on a floor of " + number(floor), {}, {}, {}, 50.0f, {}, 48};
     // Centred off the cube so the quad's diagonal passes floor/sqrt(8) away from it.
     const float h = floor / 2, x = floor / 4, z = -floor / 4;
     add_quad(c.mesh, {x - h, 0, z - h}, {x - h, 0, z + h}, {x + h, 0, z + h}, {x + h, 0, z - h});
@@ -136,7 +142,7 @@ std::vector<Case> corpus() {
         add_box(m, {0, 0, 0}, {1, 0.001f, 0.5f}, rotation(0.4f, 0.2f));
         add_cylinder(m, {0.2f, -0.6f, 0.1f}, glm::normalize(glm::vec3(0.1f, 1, 0.2f)), 0.15f, 1.2f,
                      512);
-        cases.push_back({"CAD plate and cylinder at scale " + std::to_string(scale),
+        cases.push_back({"CAD plate and cylinder at scale " + number(scale),
                          transformed(m, scale, glm::vec3(0)),
                          glm::vec3(0.5f, 1.5f, 3.0f) * scale,
                          glm::vec3(0),
@@ -435,9 +441,8 @@ Tally check_case(const Case& c) {
         const layout::RayResult& r = results[i];
         const dvec3 o(camera[i / c.lights.size()].first), d(camera[i / c.lights.size()].second);
         const dvec3 light(c.lights[i % c.lights.size()]);
-        const bool first_light = i % c.lights.size() == 0;  // one primary check per pixel
-        const PrimaryTruth truth = primary_truth(tris, o, d);
-        if (first_light) {
+        if (i % c.lights.size() == 0) {  // one camera-ray check per pixel
+            const PrimaryTruth truth = primary_truth(tris, o, d);
             ++tally.primary;
             if (truth.triangle == -2) {
                 ++tally.primary_ambiguous;
