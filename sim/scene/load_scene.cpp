@@ -96,7 +96,8 @@ public:
         if (!node.is_number())
             fail(node.source(),
                  fmt::format("{} must be a number, got a {}", name, type_name(node)));
-        const double v = *node.value<double>();
+        // toml++ gives no double for an integer beyond 2^53 (intensity = 90000000000000000).
+        const double v = node.is_integer() ? double(*node.value<int64_t>()) : *node.value<double>();
         if (!std::isfinite(v) || !allowed.contains(v))
             fail(node.source(), fmt::format("{} must be in {}, got {}", name, allowed.text(), v));
         return v;
@@ -451,10 +452,11 @@ void compile(Scene& scene, std::span<const Placement> placements, const WorldBox
 /// float steps (2^-24) for the image not to come out quantised. 2^-19 radians is 32 steps.
 constexpr double kMinRadiansPerPixel = 0x1p-19;
 
-/// Rounds up to 3 significant digits, so a range printed in a message accepts its own bound.
+/// The smallest 3-significant-digit decimal >= v, as parsed: a range printed in a message then
+/// accepts its own bound.
 double round_up_3(double v) {
-    const double step = std::pow(10.0, std::floor(std::log10(v)) - 2);
-    return std::ceil(v / step) * step;
+    const int exponent = int(std::floor(std::log10(v))) - 2;
+    return std::stod(fmt::format("{}e{}", std::ceil(v / std::pow(10.0, exponent)), exponent));
 }
 
 WorldCamera read_camera(const Reader& r, const toml::table& t, uint32_t image_height) {
@@ -468,7 +470,7 @@ WorldCamera read_camera(const Reader& r, const toml::table& t, uint32_t image_he
         const double min_fov = round_up_3(glm::degrees(kMinRadiansPerPixel * image_height));
         if (camera.fov < min_fov)
             r.fail(fov->source(),
-                   fmt::format("camera.fov must be in [{}, 180) for a {}-pixel-high image "
+                   fmt::format("camera.fov must be in [{:.3g}, 180) for a {}-pixel-high image "
                                "(narrower, float cannot tell neighbouring pixels' rays apart), "
                                "got {}",
                                min_fov, image_height, camera.fov));
