@@ -48,6 +48,7 @@ inline bool is_nan(float x) {
 struct ShearedRay {
     int kx, ky, kz;
     float ox, oy, oz;
+    float dx, dy, dz;  ///< the direction on the permuted axes
     float sx, sy, sz;
 };
 
@@ -63,8 +64,11 @@ inline ShearedRay shear(Vec3 origin, Vec3 dir) {
         r.kx = r.ky;
         r.ky = k;
     }
-    r.sx = component(dir, r.kx) / dz;
-    r.sy = component(dir, r.ky) / dz;
+    r.dx = component(dir, r.kx);
+    r.dy = component(dir, r.ky);
+    r.dz = dz;
+    r.sx = r.dx / dz;
+    r.sy = r.dy / dz;
     r.sz = 1.0f / dz;
     r.ox = component(origin, r.kx);
     r.oy = component(origin, r.ky);
@@ -72,68 +76,90 @@ inline ShearedRay shear(Vec3 origin, Vec3 dir) {
     return r;
 }
 
-/// Hit distance along the (unnormalised) direction, if the ray meets the triangle at address
-/// `tri` with t_min < t < t_max. Two-sided. The paper's double-precision fallback for edge
-/// coefficients that are exactly zero is left out (TRaX has no doubles): such rays count as
-/// hits, so a ray through a shared edge or vertex is never lost, at worst reported by both
-/// triangles. Degenerate triangles have det == 0 and never hit. Every comparison that accepts
-/// is written so that a NaN (from a NaN or infinite ray) rejects.
-/// Always inlined into the loops so the ray stays in registers across triangles.
-[[gnu::always_inline]] inline bool intersect(const ShearedRay& r, int tri, float t_min, float t_max,
-                                             float& t) {
-    // Vertices relative to the origin, sheared and scaled. One address per permuted axis, so
-    // the three vertices' coordinates on it are constant offsets from it (one flw each).
-    const int x = tri + r.kx, y = tri + r.ky, z = tri + r.kz;
-    const float a_z = loadf(z, kTriangleV0) - r.oz;
-    const float b_z = loadf(z, kTriangleV1) - r.oz;
-    const float c_z = loadf(z, kTriangleV2) - r.oz;
-    const float a_x = loadf(x, kTriangleV0) - r.ox - r.sx * a_z;
-    const float a_y = loadf(y, kTriangleV0) - r.oy - r.sy * a_z;
-    const float b_x = loadf(x, kTriangleV1) - r.ox - r.sx * b_z;
-    const float b_y = loadf(y, kTriangleV1) - r.oy - r.sy * b_z;
-    const float c_x = loadf(x, kTriangleV2) - r.ox - r.sx * c_z;
-    const float c_y = loadf(y, kTriangleV2) - r.oy - r.sy * c_z;
+/// What intersect() finds: the distance along the (unnormalised) direction, and a bound on how
+/// far the point origin + t*dir may lie from the triangle's plane because t was rounded, times
+/// the length of the plane normal cross(v1 - v0, v2 - v0) (surface_point() divides it out).
+struct TriangleHit {
+    float t;
+    float plane_error;
+};
 
-    // Scaled barycentrics: edge functions in the sheared 2D space.
+constexpr float gamma(int n) {
+    return float(n) * 0x1p-24f / (1.0f - float(n) * 0x1p-24f);
+}
+
+/// Whether the ray meets the triangle at address `tri` with 0 < t < t_max, and where. Two-sided.
+///
+/// Inside or outside: the edge functions of Woop, Benthin and Wald's watertight test. The
+/// paper's double-precision fallback for edge coefficients that are exactly zero is left out
+/// (TRaX has no doubles): such rays count as hits, so a ray through a shared edge or vertex is
+/// never lost, at worst reported by both triangles. Degenerate triangles have det == 0 and never
+/// hit. Every comparison that accepts is written so that a NaN (from a NaN or infinite ray)
+/// rejects.
+///
+/// Distance: from the plane, t = n.(v0 - o) / n.d with n = cross(v1 - v0, v2 - v0), not the
+/// paper's interpolated sheared z, which cancels catastrophically when the triangle is much
+/// larger than the hit distance (a 1e5 floor seen from 5 mm lost its hits near the camera).
+/// For an axis-aligned plane n has one non-zero component and t is exact. Both dot products
+/// carry a conservative rounding bound in the style of pbrt-v4 sec. 6.8 (Pharr, Jakob and
+/// Humphreys, 4th ed.): each term's error is at most gamma(6) times (|n_i| plus the error of n_i,
+/// itself at most |e1_j e2_k| + |e1_k e2_j| times gamma(3)) times the term's other factor. A hit
+/// whose numerator or denominator could have the wrong sign is rejected, so t > 0 is certain:
+/// a ray leaving a surface from an origin on the right side of its plane never hits it again.
+/// Always inlined into the loops so the ray stays in registers across triangles; callers that
+/// ignore the plane error (any-hit rays) do not compute it.
+[[gnu::always_inline]] inline bool intersect(const ShearedRay& r, int tri, float t_max,
+                                             TriangleHit& hit) {
+    // Vertex coordinates on the permuted axes. One address per axis, so the three vertices'
+    // coordinates on it are constant offsets from it (one flw each).
+    const int x = tri + r.kx, y = tri + r.ky, z = tri + r.kz;
+    const float x0 = loadf(x, kTriangleV0), y0 = loadf(y, kTriangleV0), z0 = loadf(z, kTriangleV0);
+    const float x1 = loadf(x, kTriangleV1), y1 = loadf(y, kTriangleV1), z1 = loadf(z, kTriangleV1);
+    const float x2 = loadf(x, kTriangleV2), y2 = loadf(y, kTriangleV2), z2 = loadf(z, kTriangleV2);
+
+    // Vertices relative to the origin, sheared so the ray runs along +z through (0, 0).
+    const float a_z = z0 - r.oz, b_z = z1 - r.oz, c_z = z2 - r.oz;
+    const float a_x = x0 - r.ox - r.sx * a_z;
+    const float a_y = y0 - r.oy - r.sy * a_z;
+    const float b_x = x1 - r.ox - r.sx * b_z;
+    const float b_y = y1 - r.oy - r.sy * b_z;
+    const float c_x = x2 - r.ox - r.sx * c_z;
+    const float c_y = y2 - r.oy - r.sy * c_z;
+
+    // Edge functions in the sheared 2D space: all of one sign inside.
     const float u = c_x * b_y - c_y * b_x;
     const float v = a_x * c_y - a_y * c_x;
     const float w = b_x * a_y - b_y * a_x;
     if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return false;
-    const float det = u + v + w;
-    if (det == 0.0f) return false;
+    if (u + v + w == 0.0f) return false;
 
-    // Scaled distance; compare before dividing so misses cost no division.
-    const float scaled_t = r.sz * (u * a_z + v * b_z + w * c_z);
-    const bool inside = det > 0.0f ? (scaled_t > t_min * det && scaled_t < t_max * det)
-                                   : (scaled_t < t_min * det && scaled_t > t_max * det);
-    if (!inside) return false;
-    t = scaled_t / det;
+    // The plane: normal from the edges (on permuted axes: the same products, so the same
+    // numbers up to sign), numerator n.(v0 - o), denominator n.d, and their rounding bounds.
+    const float e1x = x1 - x0, e1y = y1 - y0, e1z = z1 - z0;
+    const float e2x = x2 - x0, e2y = y2 - y0, e2z = z2 - z0;
+    const float px = e1y * e2z, qx = e1z * e2y, py = e1z * e2x, qy = e1x * e2z, pz = e1x * e2y,
+                qz = e1y * e2x;
+    const float nx = px - qx, ny = py - qy, nz = pz - qz;
+    // |n_i| + gamma(3)/gamma(6) * (|p_i| + |q_i|) <= 2 * (|p_i| + |q_i|): one bound for both.
+    const float mx = trax_abs(px) + trax_abs(qx), my = trax_abs(py) + trax_abs(qy),
+                mz = trax_abs(pz) + trax_abs(qz);
+    const float ax = x0 - r.ox, ay = y0 - r.oy;
+    float num = nx * ax + ny * ay + nz * a_z;
+    float den = nx * r.dx + ny * r.dy + nz * r.dz;
+    const float num_error =
+        2.0f * gamma(6) * (mx * trax_abs(ax) + my * trax_abs(ay) + mz * trax_abs(a_z));
+    const float den_error =
+        2.0f * gamma(6) * (mx * trax_abs(r.dx) + my * trax_abs(r.dy) + mz * trax_abs(r.dz));
+    if (den < 0.0f) {
+        num = -num;
+        den = -den;
+    }
+    if (!(num > num_error && den > den_error && num < t_max * den)) return false;
+    hit.t = num / den;
+    // t's rounding moves o + t*d off the plane by at most (num_error + t*den_error)/|n| plus
+    // the division's own rounding.
+    hit.plane_error = num_error + hit.t * (den_error + gamma(1) * den);
     return true;
-}
-
-/// Moves a surface point off its surface along the normal so a ray leaving it does not hit its
-/// own triangle: Wächter and Binder, "A Fast and Robust Method for Avoiding Self-Intersection",
-/// Ray Tracing Gems ch. 6, 2019. Components far from zero move a fixed number of ulps (integer
-/// arithmetic on the float bits); components near zero, where ulps are tiny, move by a float step.
-///
-/// Scale-free variant: the paper calls a component "near the origin" when |p| < 1/32 and moves
-/// it by n/65536, which assumes a scene of size ~1. But a hit point's rounding error is set by
-/// its LARGEST coordinate (the vertices and the origin it was computed from are that large), so
-/// on a 500-unit Cornell box the point (250, 0, 300) on the floor got a 1.5e-5 offset in y,
-/// below the ~3e-5 error of the hit: shadow acne. Here "near" is relative to the largest
-/// magnitude m of the point (|p_i| < m/32) and the float step is m * n_i/65536 — about 128 ulps
-/// of m, the same size as the 256-ulp integer step at m/2..m. Scaling the scene by any power of
-/// two scales every offset by it, so the test is the same at 1e-4 and 1e4.
-inline float offset_coordinate(float p, float n, float magnitude) {
-    constexpr float kNearFraction = 1.0f / 32.0f, kFloatScale = 1.0f / 65536.0f, kIntScale = 256.0f;
-    if (trax_abs(p) < magnitude * kNearFraction) return p + kFloatScale * magnitude * n;
-    const int ulps = static_cast<int>(kIntScale * n);
-    return __builtin_bit_cast(float, __builtin_bit_cast(int, p) + (p < 0.0f ? -ulps : ulps));
-}
-inline Vec3 offset_origin(Vec3 p, Vec3 n) {
-    const float m = trax_max(trax_abs(p.x), trax_max(trax_abs(p.y), trax_abs(p.z)));
-    return {offset_coordinate(p.x, n.x, m), offset_coordinate(p.y, n.y, m),
-            offset_coordinate(p.z, n.z, m)};
 }
 
 /// Counts of one ray's traversal.
@@ -177,11 +203,20 @@ struct ThreadTotals {
     }
 };
 
-/// Closest (or any) hit: image triangle index or -1, and its distance.
+/// Closest (or any) hit: image triangle index or -1, its distance and (closest-hit rays only)
+/// TriangleHit::plane_error.
 struct Hit {
     int triangle = -1;
     float t = 0.0f;
+    float plane_error = 0.0f;
 };
+
+/// Records a triangle hit found by a traversal; any-hit rays keep no error bound.
+template <bool kAnyHit> inline void record(Hit& hit, int triangle, const TriangleHit& found) {
+    hit.triangle = triangle;
+    hit.t = found.t;
+    if (!kAnyHit) hit.plane_error = found.plane_error;
+}
 
 /// A NaN anywhere in the ray, a zero direction or a t_max that is not > 0 (NaN included) means
 /// "no ray": it hits nothing and costs no traversal. Infinite components are valid inputs; the
@@ -205,10 +240,9 @@ struct BruteForce {
         const ShearedRay r = shear(origin, dir);
         for (int i = 0; i < num_triangles; ++i) {
             ++stats.triangles_tested;
-            float t;
-            if (intersect(r, triangles + i * kTriangleWords, 0.0f, hit.t, t)) {
-                hit.t = t;
-                hit.triangle = i;
+            TriangleHit found;
+            if (intersect(r, triangles + i * kTriangleWords, hit.t, found)) {
+                record<kAnyHit>(hit, i, found);
                 if (kAnyHit) break;
             }
         }
@@ -295,10 +329,9 @@ struct BvhTraversal {
             } else {
                 for (int i = first; i < first + count; ++i) {
                     ++stats.triangles_tested;
-                    float t;
-                    if (intersect(r, triangles + i * kTriangleWords, 0.0f, hit.t, t)) {
-                        hit.t = t;
-                        hit.triangle = i;
+                    TriangleHit found;
+                    if (intersect(r, triangles + i * kTriangleWords, hit.t, found)) {
+                        record<kAnyHit>(hit, i, found);
                         if (kAnyHit) return hit;
                     }
                 }
@@ -314,13 +347,59 @@ struct BvhTraversal {
     }
 };
 
-/// The face normal of the image triangle `tri` (address), unit length, facing against `dir`
-/// (two-sided surfaces).
-inline Vec3 facing_normal(int tri, Vec3 dir) {
+/// A closest hit's surface point p = origin + t*dir and a bound on its distance from the
+/// triangle's plane. The offset below follows pbrt-v4 (Pharr, Jakob and Humphreys, "Physically
+/// Based Rendering", 4th ed., sec. 6.8 "Managing Rounding Error"), with the point's error taken
+/// from this computation rather than from a barycentric reconstruction: pbrt's
+/// gamma(7) * sum |b_i v_i| bound grows with the vertices' magnitudes in every direction, so on a
+/// 1e5 floor the rebuilt point moved centimetres along the surface and 1 mm objects cast their
+/// shadows in the wrong place; o + t*d with the certain plane t of intersect() is accurate to a
+/// few ulps of |o| and |t*d| along the surface and its normal error is bounded exactly.
+struct SurfacePoint {
+    Vec3 p;
+    Vec3 n;              ///< unit face normal, on the side of v0, v1, v2's winding
+    float normal_error;  ///< bound on p's distance from the plane
+};
+
+inline Vec3 abs(Vec3 a) {
+    return {trax_abs(a.x), trax_abs(a.y), trax_abs(a.z)};
+}
+
+/// The surface point of `hit`, a closest hit of the ray (origin, dir) on the image triangle at
+/// address `tri`. p's components carry at most gamma(2) * (|o_i| + |t*d_i|) of rounding.
+inline SurfacePoint surface_point(int tri, const Hit& hit, Vec3 origin, Vec3 dir) {
     const Vec3 v0 = load_vec3(tri, kTriangleV0);
-    Vec3 n = cross(load_vec3(tri, kTriangleV1) - v0, load_vec3(tri, kTriangleV2) - v0);
-    n = n * (1.0f / trax_sqrt(dot(n, n)));
-    return dot(n, dir) > 0.0f ? n * -1.0f : n;
+    const Vec3 n = cross(load_vec3(tri, kTriangleV1) - v0, load_vec3(tri, kTriangleV2) - v0);
+    const float inverse_length = 1.0f / trax_sqrt(dot(n, n));
+    const Vec3 unit = n * inverse_length;
+    const Vec3 along = dir * hit.t;
+    const float rounding = gamma(3) * dot(abs(unit), abs(origin) + abs(along));
+    // (1 + gamma(3)) covers the rounding of the bound's own division.
+    return {origin + along, unit, hit.plane_error * inverse_length * (1.0f + gamma(3)) + rounding};
+}
+
+/// The float next to x away from zero along `sign` (> 0: up, < 0: down); x itself when it is
+/// already infinite that way. -0 and +0 both step to the smallest subnormal of that sign.
+inline float next_float(float x, float sign) {
+    if (x == 0.0f) return sign > 0.0f ? 0x1p-149f : -0x1p-149f;
+    const bool up = sign > 0.0f;
+    if (trax_abs(x) > 0x1.fffffep127f && (x > 0.0f) == up) return x;  // infinity stays
+    const int bits = __builtin_bit_cast(int, x);
+    return __builtin_bit_cast(float, (x > 0.0f) == up ? bits + 1 : bits - 1);
+}
+
+/// The origin of a ray leaving surface point s on the side `toward` points to: pbrt-v4's
+/// OffsetRayOrigin (sec. 6.8.6). p lies within normal_error of the triangle's plane, so p moved
+/// by that distance along the normal lies on the far side of the plane from every point the
+/// exact hit could be; each component is then rounded one more float away from the surface so
+/// the rounding of p + offset cannot pull it back.
+inline Vec3 offset_origin(const SurfacePoint& s, Vec3 toward) {
+    const float d = s.normal_error;
+    const Vec3 offset = s.n * (dot(toward, s.n) < 0.0f ? -d : d);
+    const Vec3 q = s.p + offset;
+    return {offset.x != 0.0f ? next_float(q.x, offset.x) : q.x,
+            offset.y != 0.0f ? next_float(q.y, offset.y) : q.y,
+            offset.z != 0.0f ? next_float(q.z, offset.z) : q.z};
 }
 
 /// What shading reads from the scene header, loaded once per thread.
@@ -344,6 +423,14 @@ struct Shading {
     }
 };
 
+/// The shadow ray from surface point s to `target` (a light): any hit on the segment, from the
+/// origin offset towards the target.
+template <class Accel>
+Hit trace_to(const Accel& accel, const SurfacePoint& s, Vec3 target, RayStats& stats) {
+    const Vec3 start = offset_origin(s, target - s.p);
+    return accel.template trace<true>(start, target - start, 1.0f, stats);
+}
+
 /// Lambert shading of the camera ray (origin, dir): ambient plus every point light facing the
 /// surface, with hard shadows (any-hit rays from the offset hit point) and 1/d^2 falloff when
 /// the scene asks for them.
@@ -355,25 +442,24 @@ Vec3 shade(const Shading& s, const Accel& accel, Vec3 origin, Vec3 dir, ThreadTo
     if (hit.triangle < 0) return s.background;
 
     const int tri = s.triangles + hit.triangle * kTriangleWords;
-    const Vec3 n = facing_normal(tri, dir);
-    const Vec3 p = origin + dir * hit.t;
+    const SurfacePoint surface = surface_point(tri, hit, origin, dir);
+    const Vec3 n = dot(surface.n, dir) > 0.0f ? surface.n * -1.0f : surface.n;  // two-sided
     const Vec3 albedo =
         load_vec3(s.materials + loadi(tri, kTriangleMaterial) * kMaterialWords, kMaterialDiffuse);
 
     Vec3 light_sum = s.ambient;
     for (int i = 0; i < s.num_lights; ++i) {
         const int light = s.lights + i * kPointLightWords;
-        const Vec3 to_light = load_vec3(light, kLightPosition) - p;
+        const Vec3 light_position = load_vec3(light, kLightPosition);
+        const Vec3 to_light = light_position - surface.p;
         const float n_dot_l = dot(n, to_light);
         if (n_dot_l <= 0.0f) continue;
         const float distance2 = dot(to_light, to_light);
         float weight = n_dot_l / trax_sqrt(distance2);  // cosine
         if (s.flags & kFeatureLightFalloff) weight = weight / distance2;
         if (s.flags & kFeatureShadows) {
-            const Vec3 start = offset_origin(p, n);
             RayStats shadow;
-            const Hit blocker = accel.template trace<true>(
-                start, load_vec3(light, kLightPosition) - start, 1.0f, shadow);
+            const Hit blocker = trace_to(accel, surface, light_position, shadow);
             totals.add(shadow, true);
             if (blocker.triangle >= 0) continue;
         }

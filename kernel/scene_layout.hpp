@@ -14,7 +14,7 @@ namespace trax::layout {
 /// "TPSC" little-endian: lets the loader and the twin reject a memory image that is not a scene.
 constexpr uint32_t kMagic = 0x4353'5054u;
 /// Bumped whenever a struct below changes shape.
-constexpr uint32_t kVersion = 2;
+constexpr uint32_t kVersion = 3;
 
 /// Sections start on 16-word (64-byte, one cache line) boundaries so no record of one section
 /// shares a line with another section.
@@ -123,8 +123,9 @@ struct ThreadStats {
 enum RayMode : int32_t {
     kRayClosestHit = 0,
     kRayAnyHit = 1,  ///< stop at the first hit, as a shadow ray does
-    /// The origin lies on triangle Ray::surface_triangle: offset it off that triangle's plane,
-    /// to the side the direction points to, as shading does for shadow rays.
+    /// Shading's two rays: the ray (a camera ray) is traced to its closest hit, then a second
+    /// ray leaves that surface point, as a shadow ray does, on the segment to Ray::target
+    /// (0 < t < 1 from the offset origin). kRayAnyHit applies to the second ray.
     kRayFromSurface = 2,
 };
 
@@ -133,14 +134,18 @@ struct Ray {
     float origin[3];
     float direction[3];
     float t_max;
-    int32_t mode;              ///< RayMode bits
-    int32_t surface_triangle;  ///< kRayFromSurface: triangle index in the image (leaf order)
+    int32_t mode;     ///< RayMode bits
+    float target[3];  ///< kRayFromSurface: where the second ray goes (a light)
 };
 
 /// What ray_query writes for one Ray.
 struct RayResult {
-    int32_t triangle;  ///< image triangle index of the hit, or -1
+    int32_t triangle;  ///< image triangle index of the hit, or -1 (kRayFromSurface: second ray)
     float t;           ///< hit distance in units of the direction; t_max when nothing was hit
+    /// kRayFromSurface: the first ray's hit (image triangle, -1 if it missed and no second ray
+    /// was traced) and distance
+    int32_t surface_triangle;
+    float surface_t;
     uint32_t nodes_visited;
     uint32_t triangles_tested;
     uint32_t max_stack_depth;
@@ -208,13 +213,15 @@ enum RecordWord : int32_t {
     kRayDirection = 3,
     kRayTMax = 6,
     kRayMode = 7,
-    kRaySurfaceTriangle = 8,
+    kRayTarget = 8,
     kResultTriangle = 0,
     kResultT = 1,
-    kResultNodesVisited = 2,
-    kResultTrianglesTested = 3,
-    kResultMaxStackDepth = 4,
-    kResultStackOverflows = 5,
+    kResultSurfaceTriangle = 2,
+    kResultSurfaceT = 3,
+    kResultNodesVisited = 4,
+    kResultTrianglesTested = 5,
+    kResultMaxStackDepth = 6,
+    kResultStackOverflows = 7,
 };
 
 // The enums above and the structs must agree, and every record must be whole words: a kernel
@@ -248,9 +255,11 @@ TRAX_LAYOUT_WORD(Ray, origin, kRayOrigin);
 TRAX_LAYOUT_WORD(Ray, direction, kRayDirection);
 TRAX_LAYOUT_WORD(Ray, t_max, kRayTMax);
 TRAX_LAYOUT_WORD(Ray, mode, kRayMode);
-TRAX_LAYOUT_WORD(Ray, surface_triangle, kRaySurfaceTriangle);
+TRAX_LAYOUT_WORD(Ray, target, kRayTarget);
 TRAX_LAYOUT_WORD(RayResult, triangle, kResultTriangle);
 TRAX_LAYOUT_WORD(RayResult, t, kResultT);
+TRAX_LAYOUT_WORD(RayResult, surface_triangle, kResultSurfaceTriangle);
+TRAX_LAYOUT_WORD(RayResult, surface_t, kResultSurfaceT);
 TRAX_LAYOUT_WORD(RayResult, nodes_visited, kResultNodesVisited);
 TRAX_LAYOUT_WORD(RayResult, triangles_tested, kResultTrianglesTested);
 TRAX_LAYOUT_WORD(RayResult, max_stack_depth, kResultMaxStackDepth);
@@ -280,7 +289,7 @@ static_assert(sizeof(Material) == 12);
 static_assert(sizeof(Triangle) == 40);
 static_assert(sizeof(BvhNode) == 32, "the BVH node is one half cache line");
 static_assert(sizeof(SceneHeader) == 124);
-static_assert(sizeof(ThreadStats) == 32 && sizeof(Ray) == 36 && sizeof(RayResult) == 24);
+static_assert(sizeof(ThreadStats) == 32 && sizeof(Ray) == 44 && sizeof(RayResult) == 32);
 
 /// Rounds a word address up to the section alignment.
 constexpr int32_t align_section(int32_t word) {

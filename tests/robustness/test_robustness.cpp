@@ -104,9 +104,12 @@ Mesh transformed(Mesh mesh, float scale, glm::vec3 offset) {
 }
 
 Ray make_ray(glm::vec3 origin, glm::vec3 dir, float t_max, int mode = trax::layout::kRayClosestHit,
-             int surface_triangle = -1) {
-    return Ray{
-        {origin.x, origin.y, origin.z}, {dir.x, dir.y, dir.z}, t_max, mode, surface_triangle};
+             glm::vec3 target = glm::vec3(0.0f)) {
+    return Ray{{origin.x, origin.y, origin.z},
+               {dir.x, dir.y, dir.z},
+               t_max,
+               mode,
+               {target.x, target.y, target.z}};
 }
 
 struct Queries {
@@ -145,7 +148,12 @@ Queries run_queries(const Mesh& mesh, const std::vector<Ray>& rays) {
         per_engine[e] = image::read_ray_results(img.header, img.words.data());
         const image::TraversalTotals totals =
             image::read_thread_stats(img.header, img.words.data());
-        CHECK(totals.rays() == rays.size());
+        // A kRayFromSurface query whose first ray hit traces a second one.
+        size_t second_rays = 0;
+        for (size_t i = 0; i < rays.size(); ++i)
+            second_rays += (rays[i].mode & trax::layout::kRayFromSurface) &&
+                           per_engine[e][i].surface_triangle >= 0;
+        CHECK(totals.rays() == rays.size() + second_rays);
         CHECK(totals.stack_overflows == 0);
     }
     REQUIRE(per_engine[0].size() == rays.size());
@@ -359,41 +367,39 @@ TEST_CASE("robustness: rays leaving a surface never hit their own triangle", "[r
     for (int k = 0; k < 4; ++k) {
         // Shared vertices and edges included: a vertex (weight 1) lies on several triangles.
         const Mesh mesh = transformed(icosphere(1), scales[k], offsets[k]);
-        const scene::Bvh bvh = bvh_for(mesh);
-        std::vector<int32_t> image_index(mesh.size());
-        for (size_t i = 0; i < bvh.triangle_order.size(); ++i)
-            image_index[bvh.triangle_order[i]] = int32_t(i);
         std::vector<Ray> rays;
-        std::vector<uint32_t> source;
-        for (uint32_t t = 0; t < mesh.size(); ++t) {
-            const scene::Triangle& tri = mesh[t];
+        for (const scene::Triangle& tri : mesh) {
             const glm::vec3 n = glm::normalize(glm::cross(tri.v1 - tri.v0, tri.v2 - tri.v0));
             for (const glm::vec3& w : weights) {
                 const glm::vec3 p = tri.v0 * w.x + tri.v1 * w.y + tri.v2 * w.z;
                 const glm::vec3 tangent = glm::normalize(tri.v1 - tri.v0);
-                // Outward to a light (a shadow ray, also at a grazing angle) and inward.
-                for (const glm::vec3& dir :
-                     {n * scales[k], (n * 0.05f + tangent) * scales[k], -n * scales[k]}) {
+                // A camera ray onto p from outside, then from its hit outward to a light (a
+                // shadow ray, also at a grazing angle) and inward through the far side.
+                const glm::vec3 eye = p + (n + tangent * 0.3f) * scales[k];
+                for (const glm::vec3& to :
+                     {n * scales[k], (n * 0.05f + tangent) * scales[k], -n * 4.0f * scales[k]}) {
                     const int mode = trax::layout::kRayFromSurface;
                     rays.push_back(
-                        make_ray(p, dir, 1.0f, mode | trax::layout::kRayAnyHit, image_index[t]));
-                    rays.push_back(make_ray(p, dir * 4.0f, kInf, mode, image_index[t]));
-                    source.insert(source.end(), 2, t);
+                        make_ray(eye, p - eye, kInf, mode | trax::layout::kRayAnyHit, p + to));
+                    rays.push_back(make_ray(eye, p - eye, kInf, mode, p + to));
                 }
             }
         }
         const Queries q = run_queries(mesh, rays);
-        size_t self_hits = 0, inward_misses = 0, outward_hits = 0;
+        size_t surface_misses = 0, self_hits = 0, inward_misses = 0, outward_hits = 0;
         for (size_t i = 0; i < rays.size(); ++i) {
             const RayResult& r = q.results[i];
-            if (r.triangle >= 0 && q.scene_triangle(r.triangle) == source[i]) ++self_hits;
-            const bool inward = (i / 2) % 3 == 2, closest = i % 2 == 1;
-            if (inward && closest && r.triangle < 0) ++inward_misses;
+            surface_misses += r.surface_triangle < 0;
+            if (r.triangle >= 0 && r.triangle == r.surface_triangle) ++self_hits;
+            const bool inward = (i / 2) % 3 == 2;
+            if (inward && r.triangle < 0) ++inward_misses;
             // A convex mesh: nothing lies outside it, along the normal.
             if ((i / 2) % 3 == 0 && r.triangle >= 0) ++outward_hits;
         }
-        INFO("scale " << scales[k] << ": " << self_hits << " self hits, " << inward_misses
-                      << " inward misses, " << outward_hits << " outward hits of " << rays.size());
+        INFO("scale " << scales[k] << ": " << surface_misses << " camera rays missed, " << self_hits
+                      << " self hits, " << inward_misses << " inward misses, " << outward_hits
+                      << " outward hits of " << rays.size());
+        CHECK(surface_misses == 0);
         CHECK(self_hits == 0);
         CHECK(inward_misses == 0);
         CHECK(outward_hits == 0);
@@ -402,31 +408,30 @@ TEST_CASE("robustness: rays leaving a surface never hit their own triangle", "[r
 
 TEST_CASE("robustness: a hit point on a large floor at y = 0 does not shadow itself",
           "[robustness]") {
-    // The Cornell box's floor. A hit point p = o + t * d carries a rounding error of a few ulps
-    // of its LARGEST coordinate (~500, ulp 3e-5) in every component, so its y lands slightly
-    // above or below 0. The paper's absolute "near the origin" step (1/65536 = 1.5e-5) cannot
-    // lift a point 1e-4 below the floor; the scale-free offset must.
+    // The Cornell box's floor seen from its camera: with the paper's absolute "near the
+    // origin" offset (1/65536) half of these points were shadowed by the floor.
     const glm::vec3 a(0.0f, 0.0f, 0.0f), b(556.0f, 0.0f, 0.0f), c(556.0f, 0.0f, 559.0f),
         d(0.0f, 0.0f, 559.0f);
     const Mesh floor = {{a, b, c}, {a, c, d}};
-    const scene::Bvh bvh = bvh_for(floor);
-    const glm::vec3 light(278.0f, 548.0f, 279.5f);
+    const glm::vec3 eye(278.0f, 273.0f, -800.0f);
     std::vector<Ray> rays;
-    for (int i = 1; i < 20; ++i)
-        for (int j = 1; j < 20; ++j)
-            for (float error : {-2e-4f, -1e-4f, -3e-5f, 0.0f, 3e-5f, 1e-4f}) {
-                const glm::vec3 p(556.0f * float(i) / 20.0f, error, 559.0f * float(j) / 20.0f);
-                // Which of the two triangles p lies on: x > z * 556/559 is triangle a-b-c.
-                const uint32_t tri = p.x * 559.0f > p.z * 556.0f ? 0 : 1;
-                const int32_t image_tri = bvh.triangle_order[0] == tri ? 0 : 1;
-                rays.push_back(make_ray(p, light - p, 1.0f,
+    for (int i = 1; i < 40; ++i)
+        for (int j = 1; j < 40; ++j) {
+            const glm::vec3 p(556.0f * float(i) / 40.0f, 0.0f, 559.0f * float(j) / 40.0f);
+            for (const glm::vec3& light :
+                 {glm::vec3(278.0f, 548.0f, 279.5f), glm::vec3(-300.0f, 20.0f, 100.0f)})
+                rays.push_back(make_ray(eye, p - eye, kInf,
                                         trax::layout::kRayFromSurface | trax::layout::kRayAnyHit,
-                                        image_tri));
-            }
+                                        light));
+        }
     const Queries q = run_queries(floor, rays);
-    size_t shadowed = 0;
-    for (const RayResult& r : q.results)
+    size_t missed = 0, shadowed = 0;
+    for (const RayResult& r : q.results) {
+        missed += r.surface_triangle < 0;
         shadowed += r.triangle >= 0;
-    INFO(shadowed << " of " << rays.size() << " floor points shadowed by the floor");
+    }
+    INFO(missed << " camera rays missed, " << shadowed << " of " << rays.size()
+                << " floor points shadowed by the floor");
+    CHECK(missed == 0);
     CHECK(shadowed == 0);
 }
