@@ -146,6 +146,7 @@ TEST_CASE("Values float cannot hold are refused with the key and the allowed ran
 }
 
 TEST_CASE("A mesh's up axis is turned to +y, exactly", "[scenespace][up]") {
+    write_file("tetra.obj", kTetraObj);
     // The same tetrahedron authored z-up: (x, y, z) -> (x, -z, y), and x-up, -y-up.
     write_file("tetra_z.obj", "v 0 0 0\nv 2 0 0\nv 0 0 3\nv 0 -5 0\n"
                               "f 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n");
