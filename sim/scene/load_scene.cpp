@@ -282,15 +282,23 @@ struct WorldBox {
 /// Scene::triangles[first, first + count), placed in the world by `to_world`, applied in double
 /// by the scene compiler once the camera is known.
 struct Placement {
+    std::string name;  ///< for messages: "meshes[0] (x.obj)", a generator, a bare mesh's path
     size_t first = 0, count = 0;
     glm::dmat4 to_world{1.0};
+    /// The farthest vertex from the geometry's own origin, in world units (scaled and turned):
+    /// float in a mesh file rounds its coordinates to about 2^-24 of this.
+    double own_reach = 0;
 };
 
-WorldBox world_bounds(const Placement& p, std::span<const Triangle> triangles) {
+/// World bounds of a placement's vertices; sets its own_reach.
+WorldBox place_in_world(Placement& p, std::span<const Triangle> triangles) {
+    const glm::dmat3 linear(p.to_world);
     WorldBox box;
     for (const Triangle& t : triangles.subspan(p.first, p.count))
-        for (const glm::vec3& v : {t.v0, t.v1, t.v2})
+        for (const glm::vec3& v : {t.v0, t.v1, t.v2}) {
             box.grow(glm::dvec3(p.to_world * glm::dvec4(glm::dvec3(v), 1.0)));
+            p.own_reach = std::max(p.own_reach, max_abs(linear * glm::dvec3(v)));
+        }
     return box;
 }
 
@@ -387,6 +395,9 @@ WorldLight default_light(const WorldCamera& camera, const WorldBox& bounds, bool
 /// coordinates (2^-53 of them) exceeds an eighth of float's resolution of the scene (2^-24 of
 /// its extent): translating the scene then moves vertices, and the user is warned.
 constexpr double kFarFromOriginRatio = 0x1p26;
+/// A mesh whose file coordinates reach more than this many frame units from the file's own
+/// origin was rounded by float in the file more coarsely (8x) than the compiled scene resolves.
+constexpr double kCoarseFileRatio = 8;
 /// Lights farther than this from the eye, in frame units (the scene fits in [-1, 1]), would
 /// overflow the kernel's float squared distance (2^128).
 constexpr double kMaxLightDistance = 0x1p60;
@@ -444,6 +455,14 @@ void compile(Scene& scene, std::span<const Placement> placements, const WorldBox
             "by more than float resolves, so moving the scene changes pixels: translate the "
             "meshes, camera and lights nearer the origin",
             source, from_origin, from_origin / extent, kFarFromOriginRatio));
+    for (const Placement& p : placements)
+        if (p.own_reach > kCoarseFileRatio * frame.unit)
+            scene.warnings.push_back(fmt::format(
+                "{}: {}: its coordinates lie up to {:.3g} from the mesh file's own origin, {:.3g} "
+                "times the scene's extent seen from the camera; float in the file rounds them to "
+                "about {:.2g}, coarser than the image resolves: export the mesh centred on its "
+                "origin and place it with translate",
+                source, p.name, p.own_reach, p.own_reach / extent, p.own_reach * 0x1p-24));
 }
 
 // --- Reading the scene file ----------------------------------------------------------------
@@ -581,13 +600,13 @@ struct Geometry {
     /// Places Scene::triangles from `first` on; fails at `where` if the world cannot hold them.
     void place(const Reader& r, const toml::source_region& where, const std::string& prefix,
                const Scene& scene, size_t first, const glm::dmat4& to_world) {
-        const Placement p{first, scene.triangles.size() - first, to_world};
-        const WorldBox box = world_bounds(p, scene.triangles);
+        Placement p{prefix, first, scene.triangles.size() - first, to_world};
+        const WorldBox box = place_in_world(p, scene.triangles);
         if (!box.finite())
             r.fail(where, fmt::format("{} reaches beyond what double precision holds "
                                       "(coordinates near 1e308); scale it down",
                                       prefix));
-        placements.push_back(p);
+        placements.push_back(std::move(p));
         bounds.grow(box);
     }
 };
@@ -618,7 +637,8 @@ void read_mesh(const Reader& r, const toml::table& t, const std::string& prefix,
         triangle.material = file_to_scene[triangle.material];
         scene.triangles.push_back(triangle);
     }
-    geometry.place(r, t.source(), prefix, scene, first, transform);
+    geometry.place(r, t.source(), fmt::format("{} ({})", prefix, path.filename().string()), scene,
+                   first, transform);
     scene.sources.push_back(mesh.summary);
 }
 
@@ -734,8 +754,8 @@ Scene scene_from_mesh(const std::filesystem::path& mesh_path, UpAxis up) {
     scene.triangles = std::move(mesh.triangles);
     scene.sources.push_back(mesh.summary);
     keep_used_materials(scene, mesh.materials);
-    const Placement placement{0, scene.triangles.size(), up_to_y(up)};
-    const WorldBox bounds = world_bounds(placement, scene.triangles);
+    Placement placement{mesh_path.filename().string(), 0, scene.triangles.size(), up_to_y(up)};
+    const WorldBox bounds = place_in_world(placement, scene.triangles);
     const WorldCamera camera = frame_bounds(bounds, double(scene.width) / double(scene.height));
     const std::string source = mesh_path.string();
     compile(scene, {&placement, 1}, bounds, camera,

@@ -215,9 +215,11 @@ TEST_CASE("The shipped scenes load", "[scenefile][shipped]") {
     REQUIRE(cornell.lights.size() == 1);
     CHECK(cornell.frame.to_world(cornell.lights[0].position).y < 548.3);  // below the light quad
     CHECK(cornell.sources[0].degenerate_triangles == 0);
+    CHECK(cornell.warnings.empty());
 
     const Scene stress = load_scene(dir / "stress.toml");
     CHECK(stress.triangles.size() >= 1'000'000);
+    CHECK(stress.warnings.empty());
     const Scene again = load_scene(dir / "stress.toml");
     CHECK(std::equal(stress.triangles.begin(), stress.triangles.end(), again.triangles.begin(),
                      [](const Triangle& a, const Triangle& b) {
@@ -225,8 +227,11 @@ TEST_CASE("The shipped scenes load", "[scenefile][shipped]") {
                                 a.material == b.material;
                      }));
 
-    if (std::filesystem::exists("/usr/share/glmark2/models/bunny.obj"))
-        CHECK(load_scene(dir / "bunny.toml").triangles.size() == 69666);
-    else
+    if (std::filesystem::exists("/usr/share/glmark2/models/bunny.obj")) {
+        const Scene bunny = load_scene(dir / "bunny.toml");
+        CHECK(bunny.triangles.size() == 69666);
+        CHECK(bunny.warnings.empty());
+    } else {
         WARN("SKIPPED bunny.toml: install glmark2-data");
+    }
 }

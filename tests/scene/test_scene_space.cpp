@@ -64,6 +64,23 @@ TEST_CASE("The scene is compiled camera-relative and scaled into [-1, 1]", "[sce
     }
 }
 
+TEST_CASE("A mesh file whose float coordinates are coarser than the render gets a warning",
+          "[scenespace][warnings]") {
+    // The tetrahedron stored 1e6 from its file's origin: float there rounds to 0.06.
+    const Scene far =
+        load_scene(write_file("far_tetra.obj", "v 1e6 0 0\nv 1000002 0 0\nv 1e6 3 0\nv 1e6 0 5\n"
+                                               "f 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n"));
+    REQUIRE(far.warnings.size() == 1);
+    CHECK_THAT(far.warnings[0], Catch::Contains("far_tetra.obj: its coordinates lie up to 1e+06 "
+                                                "from the mesh file's own origin") &&
+                                    Catch::Contains("export the mesh centred on its origin"));
+    // Stored at its origin and moved there with translate, it is exact and nothing is said.
+    write_file("tetra.obj", kTetraObj);
+    CHECK(load_scene(write_file("moved_tetra.toml",
+                                "[[meshes]]\npath = \"tetra.obj\"\ntranslate = [1e6, 0, 0]\n"))
+              .warnings.empty());
+}
+
 TEST_CASE("Camera validation is relative to the scene, not absolute", "[scenespace][errors]") {
     // 1e-25 apart is a valid camera for a scene of size 1e-25 (it was "must differ").
     CHECK(error_of("tiny_cam.toml",
