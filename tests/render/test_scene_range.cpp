@@ -110,8 +110,8 @@ std::string scaled_scene(const std::filesystem::path& mesh, int decade, bool aut
 
 // Tolerance: a scale that is not a power of two rounds the vertices (in double, then to float)
 // differently from scale 1, so a silhouette or shadow-edge pixel may flip. Measured: none here at
-// any decade (the bunny at 64x64: at most 1 of 4,096); allowed: 4 of 1,600 (0.25 %). Before the camera-relative,
-// unit-size layout, 1e-10 gave NaN pixels and 1e-16 and 1e16 black images.
+// any decade (the bunny at 64x64: at most 1 of 4,096); allowed: 4 of 1,600 (0.25 %). Before the
+// camera-relative, unit-size layout, 1e-10 gave NaN pixels and 1e-16 and 1e16 black images.
 TEST_CASE("scene range: every decade of mesh scale in [1e-30, 1e30] renders like scale 1",
           "[render][scale]") {
     const auto mesh = sphere_on_floor();
