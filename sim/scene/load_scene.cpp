@@ -38,7 +38,6 @@ struct Interval {
     }
 };
 constexpr Interval kAnyFinite{};
-constexpr Interval kPositive{0, kInf, true, true};
 constexpr Interval kNonNegative{0, kInf, false, true};
 constexpr Interval kUnit{0, 1, false, false};
 /// What goes to the kernel as a float unchanged (colours, ambient): float must hold it.
@@ -406,10 +405,11 @@ constexpr double kMaxLightDistance = 0x1p60;
 /// every vertex into [-1, 1] (0.5 <= max |v - eye| / unit < 1).
 Frame frame_of(const WorldCamera& camera, const WorldBox& bounds, const std::string& source) {
     const double reach = std::max(max_abs(bounds.lo - camera.eye), max_abs(bounds.hi - camera.eye));
-    if (!std::isfinite(reach))
-        throw SceneError(fmt::format("{}: the scene spans more than double precision holds "
-                                     "(coordinates near 1e308); scale it down",
-                                     source));
+    // Within 2^+-1000, unit and 1 / unit are both normal doubles.
+    if (!(reach < 0x1p1000) || (reach > 0 && reach < 0x1p-1000))
+        throw SceneError(fmt::format("{}: the scene reaches {:.3g} from the camera; double "
+                                     "precision holds 1e-301 to 1e301: scale it",
+                                     source, reach));
     return {camera.eye, reach > 0 ? std::ldexp(1.0, std::ilogb(reach) + 1) : 1.0};
 }
 
