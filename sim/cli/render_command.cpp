@@ -85,6 +85,7 @@ private:
 
 struct RenderCommandOptions {
     std::string scene;
+    std::string up;
     std::string output;
     std::string kernel = "tracer";
     std::string config;
@@ -108,6 +109,19 @@ struct RenderCommandOptions {
 int run_render(const RenderCommandOptions& o) {
     render::RenderOptions options;
     options.scene = o.scene;
+    if (!o.up.empty()) {
+        if (options.scene.extension() == ".toml")
+            throw Error(fmt::format("--up turns a bare mesh; in a scene file give the mesh's "
+                                    "axis as up = \"{}\" in its [[meshes]] entry",
+                                    o.up));
+        const auto up = scene::parse_up_axis(o.up);
+        if (!up)
+            throw Error(fmt::format("--up must be one of {}, got '{}'", scene::kUpAxisNames, o.up));
+        options.mesh_up = *up;
+    }
+    options.on_warning = [](const std::string& warning) {
+        fmt::print(stderr, "tpsim: warning: {}\n", warning);
+    };
     options.kernel = resolve_kernel(o.kernel);
     options.engine = o.native              ? render::Engine::native
                      : o.timing == "cycle" ? render::Engine::timing
@@ -211,6 +225,9 @@ Command add_render_command(CLI::App& app) {
     command->add_option("scene", o->scene, "Scene file or mesh")
         ->required()
         ->check(CLI::ExistingFile);
+    command->add_option("--up", o->up,
+                        "A bare mesh's up axis (x, y, z, -x, -y, -z), turned to +y: z for "
+                        "meshes authored z-up [default: y]");
     command->add_option(
         "-o,--output", o->output,
         "Image to write (.png 8-bit sRGB; .exr/.tif linear float) [default: SCENE.png]");

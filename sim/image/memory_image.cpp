@@ -21,17 +21,19 @@ void put(float (&out)[3], glm::vec3 v) {
     out[2] = v.z;
 }
 
+/// In double, narrowed once: a field of view just below 180° or a long thin image keeps its
+/// shape (the scene compiler has checked that float holds the result).
 layout::Camera compile_camera(const scene::Camera& c, uint32_t width, uint32_t height) {
-    const glm::vec3 forward = glm::normalize(c.look_at - c.eye);
-    const glm::vec3 right = glm::normalize(glm::cross(forward, c.up));
-    const glm::vec3 up = glm::cross(right, forward);
-    const float half_height = std::tan(glm::radians(c.vertical_fov_degrees) * 0.5f);
-    const float half_width = half_height * float(width) / float(height);
+    const glm::dvec3 forward = glm::normalize(glm::dvec3(c.look_at) - glm::dvec3(c.eye));
+    const glm::dvec3 right = glm::normalize(glm::cross(forward, glm::dvec3(c.up)));
+    const glm::dvec3 up = glm::cross(right, forward);
+    const double half_height = std::tan(glm::radians(c.vertical_fov_degrees) * 0.5);
+    const double half_width = half_height * double(width) / double(height);
     layout::Camera out{};
     put(out.eye, c.eye);
-    put(out.corner, forward - right * half_width + up * half_height);
-    put(out.right, right * (2.f * half_width));
-    put(out.down, up * (-2.f * half_height));
+    put(out.corner, glm::vec3(forward - right * half_width + up * half_height));
+    put(out.right, glm::vec3(right * (2.0 * half_width)));
+    put(out.down, glm::vec3(up * (-2.0 * half_height)));
     return out;
 }
 

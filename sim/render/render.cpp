@@ -73,7 +73,10 @@ InstructionCounts run_kernel(const Kernel& kernel, Engine engine, image::MemoryI
 RenderResult render(const RenderOptions& options) {
     RenderResult result;
     auto start = std::chrono::steady_clock::now();
-    result.scene = scene::load_scene(options.scene);
+    result.scene = scene::load_scene(options.scene, options.mesh_up);
+    if (options.on_warning)
+        for (const std::string& warning : result.scene.warnings)
+            options.on_warning(warning);
     if (options.image_width != 0) result.scene.width = options.image_width;
     if (options.image_height != 0) result.scene.height = options.image_height;
     result.load_seconds = seconds_since(start);

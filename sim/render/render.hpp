@@ -13,6 +13,7 @@
 #include "sim/core/elf_loader.hpp"
 #include "sim/image/memory_image.hpp"
 #include "sim/scene/bvh.hpp"
+#include "sim/scene/load_scene.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/timing/config.hpp"
 
@@ -52,8 +53,9 @@ struct Kernel {
 };
 
 struct RenderOptions {
-    std::filesystem::path scene;   ///< scene file (.toml) or a bare mesh
-    std::filesystem::path kernel;  ///< kernel ELF; its twin is found next to it
+    std::filesystem::path scene;                   ///< scene file (.toml) or a bare mesh
+    scene::UpAxis mesh_up = scene::UpAxis::pos_y;  ///< a bare mesh's up axis, turned to +y
+    std::filesystem::path kernel;                  ///< kernel ELF; its twin is found next to it
     Engine engine = Engine::functional;
     /// The BVH to build when the kernel traverses one (its ELF defines the TRAX_USES_BVH
     /// marker); other kernels get no BVH in their memory image. render() sets the depth limit
@@ -63,7 +65,9 @@ struct RenderOptions {
     uint32_t image_width = 0, image_height = 0;
     timing::ChipConfig chip;                        ///< shape (TMs x TPs) and local-store size
     uint64_t max_instructions = uint64_t(1) << 32;  ///< per thread, for runaway kernels
-    ProgressCallback on_progress;    ///< Engine::timing calls it now and then while it runs
+    ProgressCallback on_progress;  ///< Engine::timing calls it now and then while it runs
+    /// Called with each of the scene's warnings (Scene::warnings) as soon as it is loaded.
+    std::function<void(const std::string&)> on_warning;
     uint64_t timeline_interval = 0;  ///< Engine::timing: cycles per timeline row, 0 = adapt
     bool profile = false;  ///< Engine::timing: collect the source-line profile (RenderResult)
 };

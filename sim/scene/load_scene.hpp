@@ -1,7 +1,9 @@
 // Scene front end: TOML scene files (docs/scenes.md) and bare mesh files.
 #pragma once
 #include <filesystem>
+#include <optional>
 #include <span>
+#include <string_view>
 
 #include "sim/core/error.hpp"
 #include "sim/scene/bvh.hpp"
@@ -15,22 +17,23 @@ public:
     using Error::Error;
 };
 
+/// The axis a mesh was authored with pointing up. The scene compiler turns it to +y (tpsim's up)
+/// by a quarter or half turn, exactly.
+enum class UpAxis { pos_x, pos_y, pos_z, neg_x, neg_y, neg_z };
+
+/// "x", "y", "z", "-x", "-y", "-z" (a leading '+' allowed); nullopt for anything else.
+std::optional<UpAxis> parse_up_axis(std::string_view text);
+inline constexpr const char* kUpAxisNames = "x, y, z, -x, -y, -z";
+
 /// A `.toml` path is read as a scene file; anything assimp reads is loaded as a bare mesh with
-/// an automatic camera, light and material.
-Scene load_scene(const std::filesystem::path& path);
+/// an automatic camera, light and material, its `mesh_up` axis turned to +y (a scene file names
+/// the axis per mesh instead).
+Scene load_scene(const std::filesystem::path& path, UpAxis mesh_up = UpAxis::pos_y);
 
 Scene load_scene_file(const std::filesystem::path& toml_path);
-Scene scene_from_mesh(const std::filesystem::path& mesh_path);
+Scene scene_from_mesh(const std::filesystem::path& mesh_path, UpAxis up = UpAxis::pos_y);
 
 /// Bounds of all vertices; requires at least one triangle.
 Aabb bounds_of(std::span<const Triangle> triangles);
-
-/// A camera that sees the whole bounding sphere of `bounds` at the given image aspect
-/// (width / height), looking from the front (+z), a little right and above, y up.
-Camera frame_bounds(const Aabb& bounds, float aspect);
-
-/// A light above and behind the camera, bright enough that the irradiance at the centre of
-/// `bounds` is 1 (with falloff, I / d^2; without, I).
-PointLight default_light(const Camera& camera, const Aabb& bounds, bool light_falloff);
 
 }  // namespace tpsim::scene

@@ -21,7 +21,7 @@ struct Material {
 
 struct PointLight {
     glm::vec3 position{0.f};
-    glm::vec3 color{1.f};  ///< radiant intensity per channel
+    glm::vec3 color{1.f};  ///< radiant intensity per channel, in the scene frame's units
 };
 
 /// Right-handed: the image's right axis is normalize(cross(look_at - eye, up)).
@@ -29,7 +29,18 @@ struct Camera {
     glm::vec3 eye{0.f, 0.f, 1.f};
     glm::vec3 look_at{0.f};
     glm::vec3 up{0.f, 1.f, 0.f};
-    float vertical_fov_degrees = 45.f;
+    double vertical_fov_degrees = 45.0;  ///< double: 179.9999999999 must not round to 180
+};
+
+/// Where the scene's float coordinates lie in the world the scene file describes:
+/// world = origin + unit * local. The scene compiler works camera-relative (docs/scenes.md):
+/// origin is the camera's eye and unit the power of two that brings the whole scene into
+/// [-1, 1], so float precision follows the camera, not the world origin, and every scale gives
+/// the same float numbers. With light falloff, light colours are divided by unit^2 to match.
+struct Frame {
+    glm::dvec3 origin{0.0};
+    double unit = 1.0;
+    glm::dvec3 to_world(const glm::vec3& local) const { return origin + unit * glm::dvec3(local); }
 };
 
 /// What one mesh file or generator contributed, so the caller can print an import summary.
@@ -53,6 +64,8 @@ struct Scene {
     bool shadows = true;                 ///< cast a shadow ray to every light
     bool light_falloff = true;           ///< light intensity falls off with the squared distance
     std::vector<SourceSummary> sources;  ///< in the order they were loaded
+    Frame frame;  ///< triangles, camera and lights are in this frame's coordinates
+    std::vector<std::string> warnings;  ///< for the user, one line each (without "tpsim: ")
 };
 
 }  // namespace tpsim::scene

@@ -80,10 +80,13 @@ TEST_CASE("A bare mesh gets a camera that sees all of it, a light and a material
             CHECK(std::abs(glm::dot(d, right) / depth) <= tan_half * aspect);
             CHECK(std::abs(glm::dot(d, up) / depth) <= tan_half);
         }
-    // The light's default intensity makes the irradiance at the mesh centre 1 (I / d^2).
-    const glm::vec3 centre(130, 6, -2);
-    const glm::vec3 to_light = scene.lights[0].position - centre;
-    CHECK(scene.lights[0].color.x / glm::dot(to_light, to_light) == Approx(1.0).epsilon(1e-4));
+    // The light's default intensity makes the irradiance at the mesh centre 1 (I / d^2), in
+    // the frame's units as in the world's.
+    const glm::dvec3 centre(130, 6, -2);
+    const glm::dvec3 to_light = scene.frame.to_world(scene.lights[0].position) - centre;
+    const double unit = scene.frame.unit;
+    CHECK(scene.lights[0].color.x * unit * unit / glm::dot(to_light, to_light) ==
+          Approx(1.0).epsilon(1e-6));
 }
 
 TEST_CASE("Every truncation of a valid OBJ, PLY and OFF file loads or fails cleanly",
