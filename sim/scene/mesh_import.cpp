@@ -326,19 +326,35 @@ int json_nesting(std::string_view json, int limit) {
     return deepest;
 }
 
-/// Assimp's glTF readers parse the JSON recursively: a deep enough nesting overflows the stack.
+/// Assimp's glTF readers parse the JSON recursively (a deep enough nesting overflows the
+/// stack) and allocate a GLB chunk's claimed length before reading it. So the GLB framing must
+/// match the file (glTF 2: a 12-byte header with the file's length, then chunks that fit) and
+/// the JSON must nest at most kMaxJsonNesting levels.
 void check_gltf(const std::string& where, const std::string& bytes, bool binary) {
     std::string_view json = bytes;
-    if (binary) {  // GLB: a 12-byte header, then the JSON chunk's length, type and text
+    if (binary) {
+        const auto fail = [&](const std::string& why) { malformed(where, "GLB", why); };
         const auto word = [&](size_t at) {
             uint32_t value = 0;
             for (int b = 0; b < 4; ++b)
                 value |= uint32_t(static_cast<unsigned char>(bytes[at + b])) << (8 * b);
             return value;
         };
-        if (bytes.size() < 20 || bytes.compare(0, 4, "glTF") != 0)
-            malformed(where, "GLB", "no glTF header");
-        json = json.substr(20, word(12));
+        if (bytes.size() < 20 || bytes.compare(0, 4, "glTF") != 0) fail("no glTF header");
+        if (word(4) != 2) fail(fmt::format("version {}; tpsim reads glTF 2", word(4)));
+        if (word(8) != bytes.size())
+            fail(fmt::format("the header says {} bytes, the file has {}", word(8), bytes.size()));
+        for (size_t at = 12; at < bytes.size();) {
+            if (bytes.size() - at < 8) fail("a chunk header is cut off");
+            const uint32_t length = word(at);
+            if (length > bytes.size() - at - 8)
+                fail(fmt::format("a chunk of {} bytes at byte {} runs past the end", length, at));
+            if (at == 12) {
+                if (bytes.compare(16, 4, "JSON") != 0) fail("the first chunk is not JSON");
+                json = std::string_view(bytes).substr(20, length);
+            }
+            at += 8 + size_t(length);
+        }
     }
     if (json_nesting(json, kMaxJsonNesting) > kMaxJsonNesting)
         malformed(where, "glTF",

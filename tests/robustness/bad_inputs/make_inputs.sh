@@ -53,3 +53,7 @@ cat >"$out/gltf_zero.gltf" <<'GLTF'
  "bufferViews": [{"buffer": 0, "byteLength": 36}],
  "buffers": [{"uri": "zero.bin", "byteLength": 36}]}
 GLTF
+
+# glTF JSON nested 100,000 levels deep.
+{ echo -n '{"asset": {"version": "2.0"}, "extras": '; repeat '[' 100000; repeat ']' 100000
+  echo '}'; } >"$out/deep.gltf"

@@ -67,12 +67,14 @@ while IFS= read -r line || [[ -n $line ]]; do
         word=${word//@build\//$build/}
         argv+=("$word")
     done
+    started=$SECONDS
     (
         ulimit -v 2097152
         cd "$scratch" && exec timeout -k 5 20 "$tpsim" "${argv[@]}" </dev/null \
             >"$scratch/.stdout" 2>"$scratch/.stderr"
     )
     status=$?
+    ((SECONDS - started > 5)) && echo "note $name: took $((SECONDS - started)) s"
     stdout=$(cat "$scratch/.stdout")
     stderr=$(cat "$scratch/.stderr")
     lines=$(wc -l <"$scratch/.stderr")
