@@ -9,6 +9,7 @@
 #include <assimp/BaseImporter.h>
 #include <assimp/DefaultIOSystem.h>
 #include <assimp/Importer.hpp>
+#include <assimp/MemoryIOWrapper.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <fmt/format.h>
@@ -361,9 +362,9 @@ void check_gltf(const std::string& where, const std::string& bytes, bool binary)
                   fmt::format("its JSON nests more than {} levels deep", kMaxJsonNesting));
 }
 
-/// Every file assimp opens goes through tpsim's input check, so a FIFO, a device or a huge
-/// file named inside a mesh (an OBJ's mtllib, a glTF buffer's uri) cannot block the import or
-/// exhaust memory. The first refusal is kept and reported once the import returns.
+/// Every file assimp opens is read through tpsim's input check into memory, so a FIFO, a device
+/// or a huge file named inside a mesh (an OBJ's mtllib, a glTF buffer's uri) cannot block the
+/// import or exhaust memory. The first refusal is kept and reported once the import returns.
 class CheckedIOSystem : public Assimp::DefaultIOSystem {
 public:
     explicit CheckedIOSystem(std::string mesh) : mesh_(std::move(mesh)) {}
@@ -375,16 +376,19 @@ public:
     }
 
     Assimp::IOStream* Open(const char* file, const char* mode) override {
+        std::string bytes;
         try {
             if (std::string_view(mode).find_first_of("wa+") != std::string_view::npos)
                 throw Error(fmt::format("{}: the importer tried to write '{}'", mesh_, file));
-            require_input_file(file, fmt::format("file named by mesh {}", mesh_),
-                               kMaxMeshFileBytes);
+            bytes = read_input_file(file, fmt::format("file named by mesh {}", mesh_),
+                                    kMaxMeshFileBytes);
         } catch (const Error& e) {
             if (refusal_.empty()) refusal_ = e.what();
             return nullptr;
         }
-        return DefaultIOSystem::Open(file, mode);
+        auto* copy = new uint8_t[bytes.size()];
+        std::copy(bytes.begin(), bytes.end(), copy);
+        return new Assimp::MemoryIOStream(copy, bytes.size(), /*own=*/true);  // Close deletes it
     }
 
     const std::string& refusal() const { return refusal_; }

@@ -57,3 +57,9 @@ GLTF
 # glTF JSON nested 100,000 levels deep.
 { echo -n '{"asset": {"version": "2.0"}, "extras": '; repeat '[' 100000; repeat ']' 100000
   echo '}'; } >"$out/deep.gltf"
+
+# Symbolic links that lead nowhere.
+ln -s no_such_file "$out/dangling.toml"
+ln -s no_such_file "$out/dangling.obj"
+printf '[[meshes]]\npath = "dangling.obj"\n' >"$out/mesh_dangling.toml"
+printf '[[meshes]]\npath = "loop_a.obj"\n' >"$out/mesh_loop.toml"
