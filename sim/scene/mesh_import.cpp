@@ -364,7 +364,8 @@ void check_gltf(const std::string& where, const std::string& bytes, bool binary)
 
 /// Every file assimp opens is read through tpsim's input check into memory, so a FIFO, a device
 /// or a huge file named inside a mesh (an OBJ's mtllib, a glTF buffer's uri) cannot block the
-/// import or exhaust memory. The first refusal is kept and reported once the import returns.
+/// import or exhaust memory. The first refusal is kept and reported once the import returns,
+/// even when assimp would carry on without the file.
 class CheckedIOSystem : public Assimp::DefaultIOSystem {
 public:
     explicit CheckedIOSystem(std::string mesh) : mesh_(std::move(mesh)) {}
@@ -376,6 +377,8 @@ public:
     }
 
     Assimp::IOStream* Open(const char* file, const char* mode) override {
+        // A missing file is assimp's to handle: an OBJ without its .mtl gets a default material.
+        if (!Exists(file)) return nullptr;
         std::string bytes;
         try {
             if (std::string_view(mode).find_first_of("wa+") != std::string_view::npos)
@@ -463,6 +466,10 @@ ImportedMesh import_mesh(const std::filesystem::path& path) {
             throw Error(fmt::format("{}: the mesh has no faces (a point cloud?); tpsim renders "
                                     "triangles",
                                     where));
+        if (why.find("No suitable reader found") != std::string::npos)
+            throw Error(fmt::format("{}: not a {} file that assimp can read (damaged, or another "
+                                    "format under that extension)",
+                                    where, extension));
         throw Error(fmt::format("{}: cannot read mesh: {}", where, why));
     }
 
