@@ -214,6 +214,7 @@ void check_ply(const std::string& where, const std::string& bytes) {
     };
     uint64_t offset = 0;
     for (const Element& element : elements) {
+        if (element.count == 0) continue;  // it may have no properties, so no item size
         const bool has_list = std::any_of(element.properties.begin(), element.properties.end(),
                                           [](const Property& p) { return p.count_type.size != 0; });
         if (!has_list) {  // fixed-size items: one multiplication, no walk
