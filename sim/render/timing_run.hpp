@@ -39,8 +39,8 @@ inline timing::ChipLayout chip_layout(const image::MemoryImage& image,
     const auto& segments = machine.program().segments;
     if (!segments.empty())
         layout.regions.push_back({"kernel_data", segments.front().vaddr, segments.back().end()});
-    layout.text_base = machine.text_base();
-    layout.text_words = machine.text_words();
+    for (const core::Machine::CodeRange& range : machine.code())
+        layout.text.push_back({range.base, range.words});
     const auto& header = image.header;
     layout.work_items =
         uint32_t(header.rays.count > 0 ? header.rays.count : header.framebuffer.count);
