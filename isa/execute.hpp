@@ -134,8 +134,13 @@ bool csr_access(uint32_t number, uint32_t source, CsrWrite kind, bool writes, ui
 
 }  // namespace detail
 
-/// Executes one pre-decoded instruction (contract in hart.hpp).
-template <class Env> inline void execute(const Decoded& d, Hart& h, Env& env) {
+/// Executes one pre-decoded instruction (contract in hart.hpp). A pc-relative jump or branch
+/// (jal, b*) has a misaligned target exactly when its offset is misaligned
+/// (has_misaligned_offset), which decode time knows: kCheckOffsets = false skips their test, for
+/// a caller that pre-decodes such words to run them with kCheckOffsets = true (the machine's
+/// fast loop); jalr's target is always checked.
+template <class Env, bool kCheckOffsets = true>
+inline void execute(const Decoded& d, Hart& h, Env& env) {
     uint32_t npc = h.pc + 4;
 
 // Helper vocabulary of the instruction bodies (see instructions.def).
@@ -160,6 +165,13 @@ template <class Env> inline void execute(const Decoded& d, Hart& h, Env& env) {
             return;                                                                                \
         }                                                                                          \
         npc = jump_to;                                                                             \
+    } while (false)
+#define JUMP_RELATIVE(target)                                                                      \
+    do {                                                                                           \
+        if constexpr (kCheckOffsets)                                                               \
+            JUMP(target);                                                                          \
+        else                                                                                       \
+            npc = (target);                                                                        \
     } while (false)
 #define LOAD(type) env.template load<type>(RS1 + IMM)
 #define STORE(type, value) env.template store<type>(RS1 + IMM, type(value))
@@ -207,6 +219,7 @@ template <class Env> inline void execute(const Decoded& d, Hart& h, Env& env) {
 #undef FFLAGS
 #undef WRITE_RD
 #undef JUMP
+#undef JUMP_RELATIVE
 #undef LOAD
 #undef STORE
 #undef CSR

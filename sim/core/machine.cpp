@@ -30,8 +30,12 @@ Machine::Machine(Program program, const MachineConfig& config)
     for (const Segment& s : program_.segments) {
         if (!s.executable) continue;
         const CodeRange range{s.vaddr, uint32_t(s.bytes.size() / 4), uint32_t(decoded_.size())};
-        for (uint32_t word = 0; word < range.words; ++word)
-            decoded_.push_back(isa::decode(memory_.code_word(s.vaddr + 4 * word)));
+        for (uint32_t word = 0; word < range.words; ++word) {
+            const isa::Decoded d = isa::decode(memory_.code_word(s.vaddr + 4 * word));
+            // The run loops skip the target test of pc-relative jumps; the rare one with a
+            // misaligned offset takes the illegal-instruction path, which runs it with the test.
+            decoded_.push_back(isa::has_misaligned_offset(d) ? isa::Decoded{} : d);
+        }
         code_.push_back(range);
     }
     // The loader guarantees the entry lies in an executable segment; its words may still be
@@ -112,7 +116,15 @@ const Machine::CodeRange* Machine::code_range_at(uint32_t pc) const {
 }
 
 void Machine::limit_fault(uint32_t id) {
-    fault(id, threads_[id].hart.pc,
+    const Thread& t = threads_[id];
+    if (t.executed < config_.max_instructions)
+        fault(id, t.hart.pc,
+              {FaultKind::InstructionLimit,
+               fmt::format("the thread ran {} instructions on one work item (since its last "
+                           "atomicinc(0)), the limit for this scene, without finishing it",
+                           config_.max_item_instructions),
+               "look for an endless loop, or raise the limit with --max-item-instructions"});
+    fault(id, t.hart.pc,
           {FaultKind::InstructionLimit,
            fmt::format("the thread ran {} instructions (the limit) without exiting",
                        config_.max_instructions),
@@ -124,35 +136,27 @@ void Machine::run_quantum(uint32_t id, uint64_t budget) {
     isa::Hart& h = t.hart;
     ThreadEnv<false> env(*this, id);
     uint64_t* per_op = counters_.per_op.data();
-    // Locals, not members: stores through the hart's registers could alias members, and the
-    // compiler would reload them every instruction. They hold the code range the pc is in.
-    const isa::Decoded* decoded = decoded_.data() + entry_code_.first;
-    uint32_t text_base = entry_code_.base;
-    uint32_t text_words = entry_code_.words;
     uint64_t done = 0;
     uint32_t pc = h.pc;
-    // A load or store fault a trap handler takes continues the quantum at the handler.
-    for (bool trapped = true; trapped;) {
-        trapped = false;
+    const CodeRange* range = &entry_code_;
+    for (;;) {
+        // Locals, not members: stores through the hart's registers could alias members, and the
+        // compiler would reload them every instruction. Constant while the pc stays in `range`.
+        const isa::Decoded* decoded = decoded_.data() + range->first;
+        const uint32_t text_base = range->base;
+        const uint32_t text_words = range->words;
         try {
             for (; done < budget; ++done) {
                 pc = h.pc;
-                // One compare checks range and alignment: rotating moves misaligned low bits to the
-                // top. An exited thread's pc is parked at kParkedPc, so it fails here too and the
-                // loop needs no per-instruction exit test.
-                uint32_t index = std::rotr(pc - text_base, 2);
-                if (index >= text_words) [[unlikely]] {
-                    if (t.state != ThreadState::Running) break;
-                    const CodeRange* range = code_range_at(pc);
-                    if (!range) fetch_fault(id, pc);
-                    decoded = decoded_.data() + range->first;
-                    text_base = range->base;
-                    text_words = range->words;
-                    index = (pc - text_base) / 4;
-                }
+                // One compare checks range and alignment: rotating moves misaligned low bits to
+                // the top. An exited thread's pc is parked at kParkedPc, so it fails here too
+                // and the loop needs no per-instruction exit test.
+                const uint32_t index = std::rotr(pc - text_base, 2);
+                if (index >= text_words) [[unlikely]]
+                    break;
                 const isa::Decoded& d = decoded[index];
                 ++per_op[size_t(d.op)];
-                isa::execute(d, h, env);
+                isa::execute<ThreadEnv<false>, false>(d, h, env);
             }
         } catch (const GuestFault& f) {
             if (!take_trap(h, f)) {
@@ -160,9 +164,13 @@ void Machine::run_quantum(uint32_t id, uint64_t budget) {
                 counters_.instructions += done;
                 fault(id, pc, f);
             }
-            trapped = true;
+            // A load or store fault the handler takes: the quantum goes on at the handler.
             ++done;
+            continue;
         }
+        if (done == budget || t.state != ThreadState::Running) break;
+        range = code_range_at(pc);  // the pc left the range: another one, or a fetch fault
+        if (!range) fetch_fault(id, pc);
     }
     t.executed += done;
     counters_.instructions += done;
@@ -176,7 +184,7 @@ void Machine::run() {
         size_t kept = 0;
         for (uint32_t id : running) {
             Thread& t = threads_[id];
-            const uint64_t left = config_.max_instructions - t.executed;
+            const uint64_t left = instructions_left(t);
             if (left == 0) limit_fault(id);
             run_quantum(id, std::min<uint64_t>(left, config_.quantum));
             if (t.state == ThreadState::Running) running[kept++] = id;
@@ -227,8 +235,12 @@ bool Machine::read_csr(uint32_t id, uint32_t csr, uint32_t& value) const {
     }
 }
 
-void Machine::illegal(isa::Hart& h, const isa::Decoded& d) {
+void Machine::illegal(uint32_t id, isa::Hart& h, const isa::Decoded& d) {
     const uint32_t word = memory_.code_word(h.pc);
+    if (const isa::Decoded jump = isa::decode(word); isa::has_misaligned_offset(jump)) {
+        ThreadEnv<false> env(*this, id);
+        return isa::execute<ThreadEnv<false>, true>(jump, h, env);
+    }
     if (h.mtvec != 0) return isa::trap(h, isa::cause::kIllegal, word);
     if (d.op == isa::Op::Illegal)
         throw GuestFault{FaultKind::IllegalInstruction,

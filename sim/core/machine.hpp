@@ -1,5 +1,6 @@
 // The functional machine: T threads running one program over shared memory, deterministically.
 #pragma once
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <span>
@@ -25,6 +26,10 @@ struct MachineConfig {
     uint32_t read_only_global_bytes = 0;
     /// Instructions one thread may execute before it faults as a runaway (--max-instructions).
     uint64_t max_instructions = uint64_t(1) << 32;
+    /// Instructions a thread may retire on one work item, i.e. since its last tp.atominc on
+    /// global register 0 (or its start), before it faults as a runaway; 0: no such limit.
+    /// Renders set it (--max-item-instructions; render::default_item_instructions).
+    uint64_t max_item_instructions = 0;
     /// Instructions a thread runs before the functional scheduler moves to the next thread.
     uint32_t quantum = 1024;
 
@@ -45,6 +50,8 @@ struct Thread {
     /// Instructions executed, including the exit ecall and trapping ones (which instret does
     /// not count); checked against max_instructions.
     uint64_t executed = 0;
+    /// hart.instret at its last tp.atominc on global register 0 (max_item_instructions).
+    uint64_t item_start = 0;
 };
 
 /// What one instruction did, for the timing model (step()).
@@ -127,11 +134,25 @@ private:
     }
     [[noreturn]] void fetch_fault(uint32_t id, uint32_t pc);
     [[noreturn]] void limit_fault(uint32_t id);
+    /// Instructions thread `t` may still run before a limit stops it (0: stop now).
+    uint64_t instructions_left(const Thread& t) const {
+        uint64_t left = config_.max_instructions - t.executed;
+        if (config_.max_item_instructions != 0) {
+            // instret only moves back if the guest writes minstret; count that as a fresh item.
+            const uint64_t used =
+                t.hart.instret >= t.item_start ? t.hart.instret - t.item_start : 0;
+            left = std::min(left, used >= config_.max_item_instructions
+                                      ? 0
+                                      : config_.max_item_instructions - used);
+        }
+        return left;
+    }
     [[noreturn]] void refuse_step(uint32_t id);
     /// ThreadEnv's out-of-line paths (thread_env.hpp): the CSRs the machine answers (false for
-    /// others), and an illegal or unimplemented instruction (traps to mtvec or throws).
+    /// others), and an illegal or unimplemented instruction (traps to mtvec or throws), or a
+    /// pc-relative jump with a misaligned offset (pre-decoded as illegal; run here).
     bool read_csr(uint32_t id, uint32_t csr, uint32_t& value) const;
-    [[gnu::cold]] void illegal(isa::Hart& h, const isa::Decoded& d);
+    [[gnu::cold, gnu::noinline]] void illegal(uint32_t id, isa::Hart& h, const isa::Decoded& d);
     /// True if the instruction at word `index` of the code range whose decoded words start at
     /// word `first` (any index: outside the range's `words` is not private), run by hart `h`,
     /// touches only the thread's own state (registers, pc, local

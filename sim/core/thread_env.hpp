@@ -46,6 +46,8 @@ public:
         if (global_register >= kGlobalRegisters) [[unlikely]]
             bad_global_register(global_register);
         const uint32_t old = machine_.global_registers_[global_register]++;
+        // Register 0 hands out the work items (pixels): a new item starts.
+        if (global_register == 0) thread_.item_start = thread_.hart.instret;
         if constexpr (kRecord) record_->atomic_result = old;
         return old;
     }
@@ -83,7 +85,7 @@ public:
                          "a return address or function pointer is corrupt (stack smashed?)"};
     }
 
-    void illegal(isa::Hart& h, const isa::Decoded& d) { machine_.illegal(h, d); }
+    void illegal(isa::Hart& h, const isa::Decoded& d) { machine_.illegal(id_, h, d); }
 
     /// Where the next instruction's bookkeeping goes (recording environments only).
     void record_into(StepRecord* record) { record_ = record; }
@@ -128,10 +130,11 @@ private:
     if (id >= config_.threads) [[unlikely]]
         refuse_step(id);
     Thread& t = threads_[id];
-    if (t.state != ThreadState::Running || t.executed == config_.max_instructions) [[unlikely]]
+    const uint64_t left = instructions_left(t);
+    if (t.state != ThreadState::Running || left == 0) [[unlikely]]
         refuse_step(id);
-    // Stop at the instruction limit: the next call then reports the runaway at its fetch.
-    capacity = uint32_t(std::min<uint64_t>(capacity, config_.max_instructions - t.executed));
+    // Stop at the instruction limits: the next call then reports the runaway at its fetch.
+    capacity = uint32_t(std::min<uint64_t>(capacity, left));
     isa::Hart& h = t.hart;
     ThreadEnv<true> env(*this, id, out);
     // Locals, not members (as in run_quantum): stores through the hart's registers could alias
@@ -167,7 +170,7 @@ private:
             StepRecord& record = out[n];
             record = StepRecord{.pc = pc, .insn = &d};
             env.record_into(&record);
-            isa::execute(d, h, env);
+            isa::execute<ThreadEnv<true>, false>(d, h, env);
             record.taken = !record.exited && h.pc != pc + 4;
             // An exited thread's pc is parked outside the code, so it is not private either.
             if (++n == capacity ||

@@ -50,6 +50,7 @@ inline timing::ChipLayout chip_layout(const image::MemoryImage& image,
 /// How a cycle-level run is watched while it runs.
 struct TimingRunOptions {
     uint64_t max_instructions = uint64_t(1) << 32;  ///< per thread, for runaway kernels
+    uint64_t max_item_instructions = 0;             ///< per work item (0: no limit)
     uint64_t pixels = 0;                            ///< scales the progress reports (0: none)
     ProgressCallback on_progress;    ///< every timing::Chip::kProgressInterval cycles
     uint64_t timeline_interval = 0;  ///< cycles between timeline samples; 0: adapt (Timeline)
