@@ -28,6 +28,17 @@ inline const CLI::Validator kPositiveCount(
     },
     "COUNT");
 
+/// A whole number >= 0 (CLI11 wraps "-5" into an unsigned option silently).
+inline const CLI::Validator kWholeNumber(
+    [](std::string& value) -> std::string {
+        uint64_t number = 0;
+        const char* end = value.data() + value.size();
+        const auto [parsed_to, error] = std::from_chars(value.data(), end, number);
+        if (error == std::errc{} && parsed_to == end) return {};
+        return "must be a whole number >= 0 (at most 18446744073709551615), got '" + value + "'";
+    },
+    "COUNT");
+
 /// Throws tpsim::Error unless a file can be created at `path` (its directory exists); `what`
 /// names the file in the message ("the report").
 void check_output_path(const std::filesystem::path& path, const std::string& what);

@@ -274,6 +274,7 @@ Command add_render_command(CLI::App& app) {
         ->add_option("--timeline-cycles", o->timeline_cycles,
                      "Cycles per row of the statistics file's timeline; 0: adapt to the run "
                      "(200-400 rows)")
+        ->check(kWholeNumber)
         ->capture_default_str();
     command
         ->add_option("--max-instructions", o->max_instructions,

@@ -10,6 +10,8 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <toml++/toml.h>
 
+#include "sim/core/input_file.hpp"
+#include "sim/core/toml_nesting.hpp"
 #include "sim/scene/mesh_import.hpp"
 #include "sim/scene/procedural.hpp"
 
@@ -20,6 +22,8 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 /// Keeps a typo such as cells = [1e6, 1e6] from exhausting host memory.
 constexpr size_t kMaxTriangles = size_t{1} << 26;
+/// A scene file is a page of settings; its geometry is in the meshes it names.
+constexpr std::uintmax_t kMaxSceneFileBytes = 1 << 24;
 
 /// A set of allowed values, printed the way the error messages show it: "(0, 180)", "[1, 16384]".
 struct Interval {
@@ -450,11 +454,19 @@ Scene scene_from_mesh(const std::filesystem::path& mesh_path) {
 Scene load_scene_file(const std::filesystem::path& toml_path) {
     const Reader r(toml_path.string());
     std::error_code error;
-    if (!std::filesystem::is_regular_file(toml_path, error))
+    if (!std::filesystem::exists(toml_path, error))
         throw SceneError(fmt::format("{}: scene file not found", r.file()));
+    std::string text;
+    try {
+        text = read_input_file(toml_path, "scene", kMaxSceneFileBytes,
+                               "put the geometry in mesh files the scene names");
+        check_toml_nesting(text, r.file());
+    } catch (const Error& e) {
+        throw SceneError(e.what());
+    }
     toml::table root;
     try {
-        root = toml::parse_file(toml_path.string());
+        root = toml::parse(text, r.file());
     } catch (const toml::parse_error& e) {
         r.fail(e.source(), fmt::format("TOML syntax: {}", e.description()));
     }
@@ -520,9 +532,9 @@ Scene load_scene_file(const std::filesystem::path& toml_path) {
 Scene load_scene(const std::filesystem::path& path) {
     if (path.extension() == ".toml") return load_scene_file(path);
     if (is_mesh_file(path)) return scene_from_mesh(path);
-    throw SceneError(fmt::format(
-        "{}: not a scene file (.toml) nor a mesh format assimp reads (.obj, .ply, .off, ...)",
-        path.string()));
+    throw SceneError(fmt::format("{}: not a scene file (.toml), and '{}' is not a mesh format "
+                                 "tpsim reads ({})",
+                                 path.string(), path.extension().string(), mesh_format_list()));
 }
 
 }  // namespace tpsim::scene

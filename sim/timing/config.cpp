@@ -9,9 +9,15 @@
 #include <optional>
 #include <type_traits>
 
+#include "sim/core/input_file.hpp"
+#include "sim/core/toml_nesting.hpp"
+
 namespace tpsim::timing {
 
 namespace {
+
+/// A chip config is a page of keys; anything bigger is not one.
+constexpr std::uintmax_t kMaxConfigBytes = 1 << 20;
 
 struct Range {
     uint32_t min, max;
@@ -192,6 +198,7 @@ void validate(const ChipConfig& config) {
 ChipConfig parse_config(std::string_view toml_text, std::string_view source_name,
                         const ChipConfig& base) {
     ChipConfig config = base;
+    check_toml_nesting(toml_text, source_name);
     toml::table table;
     try {
         table = toml::parse(toml_text, source_name);
@@ -209,20 +216,7 @@ ChipConfig parse_config(std::string_view toml_text, std::string_view source_name
 }
 
 ChipConfig load_config(const std::string& path) {
-    toml::table table;
-    try {
-        table = toml::parse_file(path);
-    } catch (const toml::parse_error& e) {
-        throw ConfigError(fmt::format("{}:{}: {}", path, e.source().begin.line, e.description()));
-    }
-    ChipConfig config;
-    load_table(config, table, "", path);
-    try {
-        validate(config);
-    } catch (const ConfigError& e) {
-        throw ConfigError(fmt::format("{}: {}", path, e.what()));
-    }
-    return config;
+    return parse_config(read_input_file(path, "chip config", kMaxConfigBytes), path, ChipConfig{});
 }
 
 void apply_override(ChipConfig& config, std::string_view assignment) {

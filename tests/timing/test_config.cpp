@@ -4,6 +4,9 @@
 
 #include <algorithm>
 
+#include "sim/core/input_file.hpp"
+#include "sim/core/toml_nesting.hpp"
+
 using namespace tpsim::timing;
 using Catch::Contains;
 
@@ -89,4 +92,60 @@ TEST_CASE("the printed config lists every key and parses back to the same config
     CHECK_FALSE(field("dram.tCL").is_bool);
     CHECK(field("fu.atomic.pipelined").is_bool);
     CHECK(field("fu.atomic.pipelined").value == 0);
+}
+
+TEST_CASE("TOML nesting is bounded before toml++ parses the text", "[config][nesting]") {
+    const auto deep = [](const std::string& open, const std::string& close, int levels,
+                         const std::string& middle) {
+        std::string text;
+        for (int i = 0; i < levels; ++i)
+            text += open;
+        text += middle;
+        for (int i = 0; i < levels; ++i)
+            text += close;
+        return text + "\n";
+    };
+    // Each way of nesting, at the limit and one past it.
+    const int limit = tpsim::kMaxTomlNesting;
+    std::string dotted_ok;  // limit - 1 dots: a key `limit` parts long
+    for (int i = 1; i < limit; ++i)
+        dotted_ok += "a.";
+    const std::string dotted_deep = dotted_ok + "a.";
+    CHECK_NOTHROW(tpsim::check_toml_nesting(dotted_ok + "a = 1\n", "ok.toml"));
+    CHECK_THROWS_WITH(tpsim::check_toml_nesting("\n\n" + dotted_deep + "a = 1\n", "deep.toml"),
+                      Catch::StartsWith("deep.toml:3: TOML nested more than 64 levels deep"));
+    // x is level 1, each array one more.
+    CHECK_NOTHROW(tpsim::check_toml_nesting("x = " + deep("[", "]", limit - 1, "1"), "ok"));
+    CHECK_THROWS(tpsim::check_toml_nesting("x = " + deep("[", "]", limit, "1"), "deep"));
+    CHECK_NOTHROW(tpsim::check_toml_nesting("x = " + deep("{a = ", "}", limit - 1, "1"), "ok"));
+    CHECK_THROWS(tpsim::check_toml_nesting("x = " + deep("{a = ", "}", limit, "1"), "deep"));
+    CHECK_NOTHROW(tpsim::check_toml_nesting("[" + dotted_ok + "a]\n", "ok"));
+    CHECK_THROWS(tpsim::check_toml_nesting("[[" + dotted_deep + "a]]\n", "deep"));
+    // A header's depth carries over to the keys below it.
+    CHECK_THROWS(tpsim::check_toml_nesting("[" + dotted_ok + "a]\nb.c = 1\n", "deep"));
+    // 100,000 levels, the stack overflow of old, is one error.
+    CHECK_THROWS(tpsim::check_toml_nesting(deep("a.", "", 100000, "a = 1"), "deep"));
+    CHECK_THROWS_AS(parse_config(deep("a.", "", 100000, "a = 1"), "cfg.toml"), tpsim::Error);
+}
+
+TEST_CASE("the nesting scan skips strings and comments and accepts deep-looking valid TOML",
+          "[config][nesting]") {
+    std::string brackets(200, '[');
+    const std::string text = "a = \"" + brackets + "\" # " + brackets + "\n" +  //
+                             "b = '" + brackets + "'\n" +                       //
+                             "c = \"\"\"\n" + brackets + "\n\\\"\"\" \n" +      //
+                             "d = '''" + brackets + "\n'''\n" +                 //
+                             "e = [{x = 1}, {y = [1, 2]}, [], {}]\n" +          //
+                             "\"quoted.key\".f = 2.5\n" +                       //
+                             "[t]\ng = \"\"\"a\"\"\"\"\n" +                     //
+                             "[[u.v]]\nh = 1979-05-27T07:32:00Z\n";
+    CHECK_NOTHROW(tpsim::check_toml_nesting(text, "tricky.toml"));
+    // Every shipped config and scene passes.
+    for (const char* file : {"trax.toml", "tiny.toml", "../scenes/cornell.toml",
+                             "../scenes/bunny.toml", "../scenes/stress.toml"}) {
+        INFO(file);
+        const std::string path = kConfigs + "/" + file;
+        CHECK_NOTHROW(
+            tpsim::check_toml_nesting(tpsim::read_input_file(path, "test input", 1 << 20), path));
+    }
 }
