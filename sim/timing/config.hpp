@@ -144,8 +144,8 @@ void apply_override(ChipConfig& config, std::string_view assignment);
 /// (host_bytes); throws ConfigError naming the first violation.
 void validate(const ChipConfig& config);
 
-/// The most host memory a chip may need (docs/hardware-model.md, "Chip and determinism"): more is refused up front
-/// instead of ending in std::bad_alloc after minutes of allocating.
+/// The most host memory a chip may need (docs/hardware-model.md, "Chip and determinism"): more is
+/// refused up front instead of ending in std::bad_alloc after minutes of allocating.
 constexpr uint64_t kMaxHostBytes = uint64_t(8) << 30;
 
 /// One part of a chip's host memory, and the field that sizes it.
