@@ -95,15 +95,22 @@ bool csr_access(uint32_t number, uint32_t source, CsrWrite kind, bool writes, ui
             h.frm = (value >> 5) & 0x7;
         }
         return true;
+    // Zicsr: an explicit write of instret replaces the writing instruction's own increment,
+    // so the next instruction reads the value written; execute() adds that increment after
+    // this, hence the one less.
     case csr::kInstret:
     case csr::kMinstret:
         old = uint32_t(h.instret);
-        if (writes) h.instret = (h.instret & ~uint64_t{0xffff'ffff}) | combine(old);
+        if (writes) h.instret = ((h.instret & ~uint64_t{0xffff'ffff}) | combine(old)) - 1;
         return true;
     case csr::kInstretH:
     case csr::kMinstretH:
         old = uint32_t(h.instret >> 32);
-        if (writes) h.instret = uint64_t{combine(old)} << 32 | uint32_t(h.instret);
+        if (writes) h.instret = (uint64_t{combine(old)} << 32 | uint32_t(h.instret)) - 1;
+        return true;
+    case csr::kMepc:  // without the C extension mepc[1:0] are always zero
+        old = h.mepc;
+        if (writes) h.mepc = combine(old) & ~3u;
         return true;
     case csr::kMisa:  // WARL: writes are ignored
         old = kMisa;
@@ -127,8 +134,13 @@ bool csr_access(uint32_t number, uint32_t source, CsrWrite kind, bool writes, ui
 
 }  // namespace detail
 
-/// Executes one pre-decoded instruction (contract in hart.hpp).
-template <class Env> inline void execute(const Decoded& d, Hart& h, Env& env) {
+/// Executes one pre-decoded instruction (contract in hart.hpp). A pc-relative jump or branch
+/// (jal, b*) has a misaligned target exactly when its offset is misaligned
+/// (has_misaligned_offset), which decode time knows: kCheckOffsets = false skips their test, for
+/// a caller that pre-decodes such words to run them with kCheckOffsets = true (the machine's
+/// fast loop); jalr's target is always checked.
+template <class Env, bool kCheckOffsets = true>
+inline void execute(const Decoded& d, Hart& h, Env& env) {
     uint32_t npc = h.pc + 4;
 
 // Helper vocabulary of the instruction bodies (see instructions.def).
@@ -143,6 +155,24 @@ template <class Env> inline void execute(const Decoded& d, Hart& h, Env& env) {
 #define RM rm
 #define FFLAGS h.fflags
 #define WRITE_RD(value) (h.reg[d.rd] = uint32_t(value))
+// Without the C extension a target must be 4-byte aligned; a misaligned one is the jump's own
+// exception (instruction-address-misaligned): the instruction does not complete.
+#define JUMP(target)                                                                               \
+    do {                                                                                           \
+        const uint32_t jump_to = (target);                                                         \
+        if (jump_to & 3) [[unlikely]] {                                                            \
+            env.misaligned_jump(h, jump_to);                                                       \
+            return;                                                                                \
+        }                                                                                          \
+        npc = jump_to;                                                                             \
+    } while (false)
+#define JUMP_RELATIVE(target)                                                                      \
+    do {                                                                                           \
+        if constexpr (kCheckOffsets)                                                               \
+            JUMP(target);                                                                          \
+        else                                                                                       \
+            npc = (target);                                                                        \
+    } while (false)
 #define LOAD(type) env.template load<type>(RS1 + IMM)
 #define STORE(type, value) env.template store<type>(RS1 + IMM, type(value))
 #define CSR(source, kind, writes)                                                                  \
@@ -188,6 +218,8 @@ template <class Env> inline void execute(const Decoded& d, Hart& h, Env& env) {
 #undef RM
 #undef FFLAGS
 #undef WRITE_RD
+#undef JUMP
+#undef JUMP_RELATIVE
 #undef LOAD
 #undef STORE
 #undef CSR

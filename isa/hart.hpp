@@ -17,6 +17,18 @@ struct Hart {
     float f(unsigned i) const;  ///< f-register i as a float
 };
 
+/// mcause exception codes of the privileged spec (machine mode, synchronous exceptions).
+namespace cause {
+constexpr uint32_t kMisalignedFetch = 0;  ///< jump or branch to a target not 4-byte aligned
+constexpr uint32_t kIllegal = 2;
+constexpr uint32_t kBreakpoint = 3;
+constexpr uint32_t kMisalignedLoad = 4;
+constexpr uint32_t kLoadAccess = 5;
+constexpr uint32_t kMisalignedStore = 6;
+constexpr uint32_t kStoreAccess = 7;
+constexpr uint32_t kEcallM = 11;
+}  // namespace cause
+
 /// Sets the trap CSRs and jumps to mtvec (direct mode), as a machine-mode trap does.
 inline void trap(Hart& h, uint32_t cause, uint32_t tval) {
     h.mepc = h.pc;
@@ -38,9 +50,11 @@ inline void trap(Hart& h, uint32_t cause, uint32_t tval) {
 //                                                              // custom); false = not mine
 //   void env.ecall(Hart& h);  void env.ebreak(Hart& h);        // pc still at the instruction
 //   void env.illegal(Hart& h, const Decoded& d);               // pc still at the instruction
+//   void env.misaligned_jump(Hart& h, uint32_t target);        // pc still at the jump
 //
-// ecall, ebreak and illegal instructions (including unknown CSRs, writes to read-only CSRs and
-// FP instructions whose dynamic rounding mode frm is 5..7) do not complete: execute() calls the
+// ecall, ebreak, illegal instructions (including unknown CSRs, writes to read-only CSRs and
+// FP instructions whose dynamic rounding mode frm is 5..7) and jumps or taken branches to a
+// target that is not 4-byte aligned do not complete: execute() calls the
 // hook and returns without touching pc or instret, so the environment decides what follows
 // (halt the thread, emulate and advance pc itself, or call trap()). Every other instruction
 // completes: pc advances (or jumps) and instret is incremented. A load or store that throws

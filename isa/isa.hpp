@@ -97,6 +97,14 @@ const InsnInfo& info(Op op);
 /// Decodes one 32-bit word; returns op == Op::Illegal when no table entry matches.
 Decoded decode(uint32_t word);
 
+/// True for a jal or conditional branch whose offset is not a multiple of 4: taken, it jumps
+/// to a misaligned target (IALIGN = 32 without the C extension), whatever its pc.
+constexpr bool has_misaligned_offset(const Decoded& d) {
+    return (d.op == Op::jal || d.op == Op::beq || d.op == Op::bne || d.op == Op::blt ||
+            d.op == Op::bge || d.op == Op::bltu || d.op == Op::bgeu) &&
+           (d.imm & 3) != 0;
+}
+
 /// Disassembles one word as at address pc, in the syntax of llvm-objdump (e.g. "addi a0, a0, 1").
 std::string disassemble(uint32_t word, uint32_t pc);
 

@@ -104,6 +104,7 @@ struct RenderCommandOptions {
     std::string heatmap_scale = "log";
     std::string html;
     uint64_t max_instructions = uint64_t(1) << 32;
+    uint64_t max_item_instructions = 0;
 };
 
 int run_render(const RenderCommandOptions& o) {
@@ -127,6 +128,7 @@ int run_render(const RenderCommandOptions& o) {
                      : o.timing == "cycle" ? render::Engine::timing
                                            : render::Engine::functional;
     options.max_instructions = o.max_instructions;
+    options.max_item_instructions = o.max_item_instructions;
     options.timeline_interval = o.timeline_cycles;
     if (!o.config.empty()) options.chip = timing::load_config(o.config);
     for (const std::string& assignment : o.overrides)
@@ -296,6 +298,12 @@ Command add_render_command(CLI::App& app) {
                      "Instructions a thread may run before it is stopped as a runaway")
         ->check(kPositiveCount)
         ->capture_default_str();
+    command
+        ->add_option("--max-item-instructions", o->max_item_instructions,
+                     "Instructions a thread may run on one pixel (between two atomicinc(0)) "
+                     "before it is stopped as a runaway [default: 2^22 per ray, or 256 per "
+                     "triangle per ray, times the rays of a pixel]")
+        ->check(kPositiveCount);
     return {command, [o] { return run_render(*o); }};
 }
 

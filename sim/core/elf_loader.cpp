@@ -5,7 +5,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <iterator>
 #include <map>
 #include <memory>
@@ -20,6 +19,7 @@
 
 #include "kernel/memory_map.hpp"
 #include "sim/core/error.hpp"
+#include "sim/core/input_file.hpp"
 
 namespace tpsim::core {
 
@@ -399,22 +399,19 @@ Program load_elf(std::span<const uint8_t> image, const std::string& name) {
         reject(name, fmt::format("entry point {:#010x} is not in an executable segment; define "
                                  "_start (or pass -e to the linker)",
                                  program.entry));
+    if (program.entry % 4 != 0)
+        reject(name, fmt::format("entry point {:#010x} is not 4-byte aligned; align _start to 4",
+                                 program.entry));
     program.functions = read_functions(elf.get(), program.segments);
     read_lines(elf.get(), program);
     return program;
 }
 
 Program load_elf(const std::string& path) {
-    // Reading a directory through an ifstream throws an unhelpful std::ios_base::failure.
-    if (std::error_code ec; std::filesystem::is_directory(path, ec))
-        throw Error(
-            fmt::format("cannot load '{}': it is a directory; give the path of an ELF file", path));
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error(fmt::format("cannot open '{}': no such file or not readable", path));
-    std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)),
-                               std::istreambuf_iterator<char>());
-    if (in.bad()) throw Error(fmt::format("cannot read '{}': I/O error", path));
-    return load_elf(bytes, path);
+    const std::string bytes = read_input_file(
+        path, "kernel", kMaxElfBytes,
+        "check that it is a kernel ELF, or strip its debug information (llvm-strip -g)");
+    return load_elf({reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size()}, path);
 }
 
 }  // namespace tpsim::core

@@ -84,7 +84,12 @@ public:
 /// itself when it is not a mangled C++ name.
 std::string demangle(const std::string& name);
 
-/// Reads and validates an ELF file. Throws tpsim::Error (one line naming the file, the problem
+/// The largest kernel ELF file tpsim reads (program and debug information): the program itself
+/// must fit in the 256 MiB below global memory (docs/memory-map.md); a -g kernel is about 1 MiB.
+constexpr uint64_t kMaxElfBytes = uint64_t(64) << 20;
+
+/// Reads (through read_input_file: regular files of at most kMaxElfBytes) and validates an ELF
+/// file. Throws tpsim::Error (one line naming the file, the problem
 /// and the fix) for anything tpsim cannot run.
 Program load_elf(const std::string& path);
 

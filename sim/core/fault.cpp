@@ -10,6 +10,8 @@ std::string_view to_string(FaultKind kind) {
         return "unmapped access";
     case FaultKind::Misaligned:
         return "misaligned access";
+    case FaultKind::MisalignedJump:
+        return "misaligned jump";
     case FaultKind::WriteToReadOnly:
         return "write to read-only memory";
     case FaultKind::StackOverflow:

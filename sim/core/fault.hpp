@@ -4,17 +4,19 @@
 #include <string>
 #include <string_view>
 
+#include "isa/hart.hpp"
 #include "sim/core/error.hpp"
 
 namespace tpsim::core {
 
 enum class FaultKind : uint8_t {
-    NullAccess,        ///< load/store below kCodeBase
-    Unmapped,          ///< load/store to an address no region maps
-    Misaligned,        ///< load/store/fetch not aligned to its size (TRaX has no unaligned access)
-    WriteToReadOnly,   ///< store into text/rodata
-    StackOverflow,     ///< access just below the thread's local store
-    FetchOutsideCode,  ///< pc left the executable segments
+    NullAccess,          ///< load/store below kCodeBase
+    Unmapped,            ///< load/store to an address no region maps
+    Misaligned,          ///< load/store not aligned to its size (TRaX has no unaligned access)
+    MisalignedJump,      ///< jump or taken branch to a target that is not 4-byte aligned
+    WriteToReadOnly,     ///< store into text/rodata
+    StackOverflow,       ///< access just below the thread's local store
+    FetchOutsideCode,    ///< pc left the executable segments
     IllegalInstruction,  ///< word that decodes to no instruction, or an unknown CSR
     Breakpoint,          ///< ebreak
     UnsupportedEcall,    ///< ecall other than exit, with no trap handler installed
@@ -24,12 +26,19 @@ enum class FaultKind : uint8_t {
 
 std::string_view to_string(FaultKind kind);
 
+/// GuestFault::mcause of a fault that stops the thread even when it has a trap handler.
+constexpr uint32_t kNoTrap = UINT32_MAX;
+
 /// Raised inside an instruction by memory or the environment; the machine catches it and
-/// rethrows a Fault that names the thread, pc, function, source line and instruction.
+/// either traps to the thread's handler (mcause set and mtvec != 0, as the privileged spec
+/// has it) or rethrows a Fault that names the thread, pc, function, source line and
+/// instruction.
 struct GuestFault {
     FaultKind kind;
-    std::string detail;  ///< what the instruction did, e.g. "writes 0x7ffff7fc, below ..."
-    std::string hint;    ///< how to fix it
+    std::string detail;         ///< what the instruction did, e.g. "writes 0x7ffff7fc, below ..."
+    std::string hint;           ///< how to fix it
+    uint32_t mcause = kNoTrap;  ///< isa::cause of the exception a handler may take
+    uint32_t mtval = 0;         ///< its mtval (the faulting address)
 };
 
 /// The one-line, user-facing fault.

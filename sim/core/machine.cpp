@@ -23,18 +23,24 @@ Machine::Machine(Program program, const MachineConfig& config)
       memory_(program_, MemoryConfig{config.global_bytes, config.read_only_global_bytes,
                                      config.local_store_bytes, config.threads}) {
     config_.validate();
-    // Decode the file-backed span of the executable segments once. Words in gaps between them
-    // decode as illegal and are reported as fetches outside the code; a zero-filled tail (memsz
-    // beyond filesz) is not decoded, so a huge bogus memsz costs nothing (see fetch_fault).
-    uint32_t lo = UINT32_MAX, hi = 0;
-    for (const Segment& s : program_.segments)
-        if (s.executable)
-            lo = std::min(lo, s.vaddr), hi = std::max(hi, s.vaddr + uint32_t(s.bytes.size()));
-    text_base_ = lo;
-    text_bytes_ = (hi - lo) & ~3u;
-    decoded_.reserve(text_bytes_ / 4);
-    for (uint32_t addr = lo; addr - lo < text_bytes_; addr += 4)
-        decoded_.push_back(isa::decode(memory_.code_word(addr)));
+    // Decode the file-backed words of each executable segment once, and nothing else: no
+    // other segment's bytes can run, and a zero-filled tail (memsz beyond filesz) is not
+    // decoded, so a huge bogus memsz or a wide gap between code segments costs nothing (see
+    // fetch_fault).
+    for (const Segment& s : program_.segments) {
+        if (!s.executable) continue;
+        const CodeRange range{s.vaddr, uint32_t(s.bytes.size() / 4), uint32_t(decoded_.size())};
+        for (uint32_t word = 0; word < range.words; ++word) {
+            const isa::Decoded d = isa::decode(memory_.code_word(s.vaddr + 4 * word));
+            // The run loops skip the target test of pc-relative jumps; the rare one with a
+            // misaligned offset takes the illegal-instruction path, which runs it with the test.
+            decoded_.push_back(isa::has_misaligned_offset(d) ? isa::Decoded{} : d);
+        }
+        code_.push_back(range);
+    }
+    // The loader guarantees the entry lies in an executable segment; its words may still be
+    // zero fill, which the first fetch reports.
+    if (const CodeRange* entry = code_range_at(program_.entry & ~3u)) entry_code_ = *entry;
     privacy_.reserve(decoded_.size());
     for (const isa::Decoded& d : decoded_) {
         switch (isa::info(d.op).fu) {
@@ -92,19 +98,33 @@ void Machine::fetch_fault(uint32_t id, uint32_t pc) {
                "word 0x00000000 (zero fill past the end of the code) is not an RV32IMF "
                "instruction",
                "the pc ran off the end of the code; check the linker script"});
-    if (pc % 4 != 0 && segment && segment->executable)
-        fault(id, pc,
-              {FaultKind::Misaligned, "jump to a pc that is not 4-byte aligned",
-               "a return address or function pointer is corrupt (stack smashed?)"});
+    std::string ranges;
+    for (const CodeRange& range : code_)
+        ranges += fmt::format("{}[{:#010x}, {:#010x})", ranges.empty() ? "" : " ", range.base,
+                              uint64_t(range.base) + 4 * uint64_t(range.words));
     fault(id, pc,
           {FaultKind::FetchOutsideCode,
-           fmt::format("fetch from {:#010x}, outside the code [{:#010x}, {:#010x})", pc, text_base_,
-                       text_base_ + text_bytes_),
+           fmt::format("fetch from {:#010x}, outside the code {}", pc, ranges),
            "a return address or function pointer is null or corrupt (stack smashed?)"});
 }
 
+const Machine::CodeRange* Machine::code_range_at(uint32_t pc) const {
+    if (pc % 4 != 0) return nullptr;
+    for (const CodeRange& range : code_)
+        if ((pc - range.base) / 4 < range.words) return &range;
+    return nullptr;
+}
+
 void Machine::limit_fault(uint32_t id) {
-    fault(id, threads_[id].hart.pc,
+    const Thread& t = threads_[id];
+    if (t.executed < config_.max_instructions)
+        fault(id, t.hart.pc,
+              {FaultKind::InstructionLimit,
+               fmt::format("the thread ran {} instructions on one work item (since its last "
+                           "atomicinc(0)), the limit for this scene, without finishing it",
+                           config_.max_item_instructions),
+               "look for an endless loop, or raise the limit with --max-item-instructions"});
+    fault(id, t.hart.pc,
           {FaultKind::InstructionLimit,
            fmt::format("the thread ran {} instructions (the limit) without exiting",
                        config_.max_instructions),
@@ -116,32 +136,41 @@ void Machine::run_quantum(uint32_t id, uint64_t budget) {
     isa::Hart& h = t.hart;
     ThreadEnv<false> env(*this, id);
     uint64_t* per_op = counters_.per_op.data();
-    const isa::Decoded* decoded = decoded_.data();
-    // Locals, not members: stores through the hart's registers could alias members, and the
-    // compiler would reload them every instruction.
-    const uint32_t text_base = text_base_;
-    const uint32_t text_words = text_bytes_ / 4;
     uint64_t done = 0;
     uint32_t pc = h.pc;
-    try {
-        for (; done < budget; ++done) {
-            pc = h.pc;
-            // One compare checks range and alignment: rotating moves misaligned low bits to the
-            // top. An exited thread's pc is parked at kParkedPc, so it fails here too and the
-            // loop needs no per-instruction exit test.
-            const uint32_t index = std::rotr(pc - text_base, 2);
-            if (index >= text_words) [[unlikely]] {
-                if (t.state != ThreadState::Running) break;
-                fetch_fault(id, pc);
+    const CodeRange* range = &entry_code_;
+    for (;;) {
+        // Locals, not members: stores through the hart's registers could alias members, and the
+        // compiler would reload them every instruction. Constant while the pc stays in `range`.
+        const isa::Decoded* decoded = decoded_.data() + range->first;
+        const uint32_t text_base = range->base;
+        const uint32_t text_words = range->words;
+        try {
+            for (; done < budget; ++done) {
+                pc = h.pc;
+                // One compare checks range and alignment: rotating moves misaligned low bits to
+                // the top. An exited thread's pc is parked at kParkedPc, so it fails here too
+                // and the loop needs no per-instruction exit test.
+                const uint32_t index = std::rotr(pc - text_base, 2);
+                if (index >= text_words) [[unlikely]]
+                    break;
+                const isa::Decoded& d = decoded[index];
+                ++per_op[size_t(d.op)];
+                isa::execute<ThreadEnv<false>, false>(d, h, env);
             }
-            const isa::Decoded& d = decoded[index];
-            ++per_op[size_t(d.op)];
-            isa::execute(d, h, env);
+        } catch (const GuestFault& f) {
+            if (!take_trap(h, f)) {
+                t.executed += done;
+                counters_.instructions += done;
+                fault(id, pc, f);
+            }
+            // A load or store fault the handler takes: the quantum goes on at the handler.
+            ++done;
+            continue;
         }
-    } catch (const GuestFault& f) {
-        t.executed += done;
-        counters_.instructions += done;
-        fault(id, pc, f);
+        if (done == budget || t.state != ThreadState::Running) break;
+        range = code_range_at(pc);  // the pc left the range: another one, or a fetch fault
+        if (!range) fetch_fault(id, pc);
     }
     t.executed += done;
     counters_.instructions += done;
@@ -155,7 +184,7 @@ void Machine::run() {
         size_t kept = 0;
         for (uint32_t id : running) {
             Thread& t = threads_[id];
-            const uint64_t left = config_.max_instructions - t.executed;
+            const uint64_t left = instructions_left(t);
             if (left == 0) limit_fault(id);
             run_quantum(id, std::min<uint64_t>(left, config_.quantum));
             if (t.state == ThreadState::Running) running[kept++] = id;
@@ -208,9 +237,11 @@ bool Machine::read_csr(uint32_t id, uint32_t csr, uint32_t& value) const {
 
 void Machine::illegal(uint32_t id, isa::Hart& h, const isa::Decoded& d) {
     const uint32_t word = memory_.code_word(h.pc);
-    const Segment* segment = program_.segment_at(h.pc);
-    if (!segment || !segment->executable) fetch_fault(id, h.pc);
-    if (h.mtvec != 0) return isa::trap(h, detail::kCauseIllegal, word);
+    if (const isa::Decoded jump = isa::decode(word); isa::has_misaligned_offset(jump)) {
+        ThreadEnv<false> env(*this, id);
+        return isa::execute<ThreadEnv<false>, true>(jump, h, env);
+    }
+    if (h.mtvec != 0) return isa::trap(h, isa::cause::kIllegal, word);
     if (d.op == isa::Op::Illegal)
         throw GuestFault{FaultKind::IllegalInstruction,
                          fmt::format("word {:#010x} is not an RV32IMF instruction", word),

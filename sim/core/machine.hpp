@@ -1,5 +1,6 @@
 // The functional machine: T threads running one program over shared memory, deterministically.
 #pragma once
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <span>
@@ -25,6 +26,10 @@ struct MachineConfig {
     uint32_t read_only_global_bytes = 0;
     /// Instructions one thread may execute before it faults as a runaway (--max-instructions).
     uint64_t max_instructions = uint64_t(1) << 32;
+    /// Instructions a thread may retire on one work item, i.e. since its last tp.atominc on
+    /// global register 0 (or its start), before it faults as a runaway; 0: no such limit.
+    /// Renders set it (--max-item-instructions; render::default_item_instructions).
+    uint64_t max_item_instructions = 0;
     /// Instructions a thread runs before the functional scheduler moves to the next thread.
     uint32_t quantum = 1024;
 
@@ -45,6 +50,8 @@ struct Thread {
     /// Instructions executed, including the exit ecall and trapping ones (which instret does
     /// not count); checked against max_instructions.
     uint64_t executed = 0;
+    /// hart.instret at its last tp.atominc on global register 0 (max_item_instructions).
+    uint64_t item_start = 0;
 };
 
 /// What one instruction did, for the timing model (step()).
@@ -99,9 +106,14 @@ public:
     Thread& thread(uint32_t id) { return threads_.at(id); }
     const Thread& thread(uint32_t id) const { return threads_.at(id); }
     uint32_t thread_count() const { return uint32_t(threads_.size()); }
-    /// The executable range: text_words() instruction words from text_base().
-    uint32_t text_base() const { return text_base_; }
-    uint32_t text_words() const { return text_bytes_ / 4; }
+    /// The code: the file-backed words of each executable segment, by address. Only these
+    /// are decoded and fetched; a pc anywhere else is a fetch fault.
+    struct CodeRange {
+        uint32_t base = 0;   ///< address of the first word
+        uint32_t words = 0;  ///< instruction words
+        uint32_t first = 0;  ///< index of the first word in the decoded array
+    };
+    const std::vector<CodeRange>& code() const { return code_; }
     const Counters& counters() const { return counters_; }
     uint32_t global_register(uint32_t index) const { return global_registers_.at(index); }
 
@@ -109,28 +121,54 @@ private:
     template <bool kRecord> friend class ThreadEnv;
 
     void run_quantum(uint32_t id, uint64_t budget);
+    /// The code range holding the aligned pc, or nullptr (a fetch fault). Cold: the run loops
+    /// keep the current range in locals and ask only when the pc leaves it.
+    [[gnu::cold]] const CodeRange* code_range_at(uint32_t pc) const;
     [[noreturn]] void fault(uint32_t id, uint32_t pc, const GuestFault& what);
+    /// Traps the hart to its handler if it has one and the fault is an exception a handler
+    /// may take (a load or store fault); false if the fault must stop the thread.
+    static bool take_trap(isa::Hart& h, const GuestFault& what) {
+        if (h.mtvec == 0 || what.mcause == kNoTrap) return false;
+        isa::trap(h, what.mcause, what.mtval);
+        return true;
+    }
     [[noreturn]] void fetch_fault(uint32_t id, uint32_t pc);
     [[noreturn]] void limit_fault(uint32_t id);
+    /// Instructions thread `t` may still run before a limit stops it (0: stop now).
+    uint64_t instructions_left(const Thread& t) const {
+        uint64_t left = config_.max_instructions - t.executed;
+        if (config_.max_item_instructions != 0) {
+            // instret only moves back if the guest writes minstret; count that as a fresh item.
+            const uint64_t used =
+                t.hart.instret >= t.item_start ? t.hart.instret - t.item_start : 0;
+            left = std::min(left, used >= config_.max_item_instructions
+                                      ? 0
+                                      : config_.max_item_instructions - used);
+        }
+        return left;
+    }
     [[noreturn]] void refuse_step(uint32_t id);
     /// ThreadEnv's out-of-line paths (thread_env.hpp): the CSRs the machine answers (false for
-    /// others), and an illegal or unimplemented instruction (traps to mtvec or throws).
+    /// others), and an illegal or unimplemented instruction (traps to mtvec or throws), or a
+    /// pc-relative jump with a misaligned offset (pre-decoded as illegal; run here).
     bool read_csr(uint32_t id, uint32_t csr, uint32_t& value) const;
-    [[gnu::cold]] void illegal(uint32_t id, isa::Hart& h, const isa::Decoded& d);
-    /// True if the instruction at text word `index` (any value: outside the text is not
-    /// private), run by hart `h`, touches only the thread's own state (registers, pc, local
+    [[gnu::cold, gnu::noinline]] void illegal(uint32_t id, isa::Hart& h, const isa::Decoded& d);
+    /// True if the instruction at word `index` of the code range whose decoded words start at
+    /// word `first` (any index: outside the range's `words` is not private), run by hart `h`,
+    /// touches only the thread's own state (registers, pc, local
     /// store) or reads the read-only scene: executing it earlier or later than other threads'
     /// instructions cannot change any result. False for shared-memory accesses, atomics and
     /// CSR/system instructions (whose results may depend on when they run). Defined in
     /// thread_env.hpp.
-    inline bool is_private(const isa::Hart& h, uint32_t index, uint32_t text_words) const;
+    inline bool is_private(const isa::Hart& h, uint32_t index, uint32_t words,
+                           uint32_t first) const;
 
     Program program_;
     MachineConfig config_;
     Memory memory_;
-    uint32_t text_base_ = 0;
-    uint32_t text_bytes_ = 0;
-    std::vector<isa::Decoded> decoded_;  ///< the executable range, one entry per word
+    std::vector<CodeRange> code_;        ///< by address
+    CodeRange entry_code_;               ///< the range holding the entry, where fetch starts
+    std::vector<isa::Decoded> decoded_;  ///< every code range's words, back to back
     /// Per word of decoded_: whether the instruction is private (is_private): always,
     /// never, or depending on the address it loads from or stores to.
     enum class Privacy : uint8_t { Always, Never, Load, Store };

@@ -51,7 +51,8 @@ Memory::Memory(const Program& program, const MemoryConfig& config) {
     config.validate();
     for (const Segment& s : program.segments) {
         Buffer buffer = zeroed<Buffer>(s.memsz, "program segment");
-        std::memcpy(buffer.get(), s.bytes.data(), s.bytes.size());
+        // A segment may have no file bytes (.bss alone): then bytes.data() may be null.
+        if (!s.bytes.empty()) std::memcpy(buffer.get(), s.bytes.data(), s.bytes.size());
         program_regions_.push_back({s.vaddr, s.memsz, buffer.get(), s.writable});
         program_buffers_.push_back(std::move(buffer));
     }
@@ -73,21 +74,21 @@ uint32_t Memory::code_word(uint32_t addr) const {
     return 0;
 }
 
-void Memory::fault(uint32_t addr, uint32_t bytes, bool store) const {
+GuestFault Memory::classify(uint32_t addr, uint32_t bytes, bool store) const {
     const char* verb = store ? "writes" : "reads";
     const std::string what =
         fmt::format("{} {} byte{} at {:#010x}", verb, bytes, bytes == 1 ? "" : "s", addr);
     if (addr < kCodeBase)
-        throw GuestFault{
+        return GuestFault{
             FaultKind::NullAccess,
             fmt::format("{}, inside the unmapped null guard {}", what, range(0, kCodeBase)),
             "check for a null or uninitialised pointer"};
     if (addr >= kLocalTop - kStackGuard && addr < local_.base)
-        throw GuestFault{FaultKind::StackOverflow,
-                         fmt::format("{}, below the {}-byte local store {}", what, local_.size,
-                                     range(local_.base, kLocalTop)),
-                         "reduce recursion/locals or enlarge the local store "
-                         "(exec --local-store N, render --set tp.local_store_bytes=N)"};
+        return GuestFault{FaultKind::StackOverflow,
+                          fmt::format("{}, below the {}-byte local store {}", what, local_.size,
+                                      range(local_.base, kLocalTop)),
+                          "reduce recursion/locals or enlarge the local store "
+                          "(exec --local-store N, render --set tp.local_store_bytes=N)"};
 
     const Region* region = nullptr;
     if (addr - local_.base < local_.size)
@@ -98,41 +99,52 @@ void Memory::fault(uint32_t addr, uint32_t bytes, bool store) const {
         if (r.holds(addr, 1)) region = &r;
 
     if (region && (addr & (bytes - 1)) != 0)
-        throw GuestFault{FaultKind::Misaligned,
-                         fmt::format("{}, which is not {}-byte aligned (TRaX hardware does not "
-                                     "support misaligned accesses)",
-                                     what, bytes),
-                         "align the data (alignas, packed structs) or access it byte by byte"};
+        return GuestFault{FaultKind::Misaligned,
+                          fmt::format("{}, which is not {}-byte aligned (TRaX hardware does not "
+                                      "support misaligned accesses)",
+                                      what, bytes),
+                          "align the data (alignas, packed structs) or access it byte by byte"};
     if (region && !region->holds(addr, bytes))
-        throw GuestFault{FaultKind::Unmapped,
-                         fmt::format("{}, running past the end of {}", what,
-                                     range(region->base, uint64_t(region->base) + region->size)),
-                         "check array bounds and the size of the scene image"};
+        return GuestFault{FaultKind::Unmapped,
+                          fmt::format("{}, running past the end of {}", what,
+                                      range(region->base, uint64_t(region->base) + region->size)),
+                          "check array bounds and the size of the scene image"};
     if (region == &global_ && store && in_read_only_global(addr))
-        throw GuestFault{
+        return GuestFault{
             FaultKind::WriteToReadOnly,
             fmt::format("{}, inside the read-only scene data {}", what,
                         range(global_.base, uint64_t(global_.base) + read_only_global_)),
             "the scene (header to BVH) is read-only while a kernel runs; write "
             "results to the framebuffer, thread_stats or ray_results sections"};
     if (region && store && !region->writable)
-        throw GuestFault{FaultKind::WriteToReadOnly,
-                         fmt::format("{}, inside the read-only program segment {}", what,
-                                     range(region->base, uint64_t(region->base) + region->size)),
-                         "code and constants are read-only; write to .data/.bss, the stack or "
-                         "global memory"};
-    throw GuestFault{FaultKind::Unmapped,
-                     fmt::format("{}, which no region maps (program {} .. global {} .. local "
-                                 "store {})",
-                                 what,
-                                 program_regions_.empty()
-                                     ? std::string("none")
-                                     : range(program_regions_.front().base,
-                                             uint64_t(program_regions_.back().base) +
-                                                 program_regions_.back().size),
-                                 range(global_.base, uint64_t(global_.base) + global_.size),
-                                 range(local_.base, kLocalTop)),
-                     "check pointer arithmetic and array bounds (see docs/memory-map.md)"};
+        return GuestFault{FaultKind::WriteToReadOnly,
+                          fmt::format("{}, inside the read-only program segment {}", what,
+                                      range(region->base, uint64_t(region->base) + region->size)),
+                          "code and constants are read-only; write to .data/.bss, the stack or "
+                          "global memory"};
+    return GuestFault{FaultKind::Unmapped,
+                      fmt::format("{}, which no region maps (program {} .. global {} .. local "
+                                  "store {})",
+                                  what,
+                                  program_regions_.empty()
+                                      ? std::string("none")
+                                      : range(program_regions_.front().base,
+                                              uint64_t(program_regions_.back().base) +
+                                                  program_regions_.back().size),
+                                  range(global_.base, uint64_t(global_.base) + global_.size),
+                                  range(local_.base, kLocalTop)),
+                      "check pointer arithmetic and array bounds (see docs/memory-map.md)"};
+}
+
+void Memory::fault(uint32_t addr, uint32_t bytes, bool store) const {
+    GuestFault fault = classify(addr, bytes, store);
+    namespace c = isa::cause;
+    if (fault.kind == FaultKind::Misaligned)
+        fault.mcause = store ? c::kMisalignedStore : c::kMisalignedLoad;
+    else
+        fault.mcause = store ? c::kStoreAccess : c::kLoadAccess;
+    fault.mtval = addr;
+    throw fault;
 }
 
 }  // namespace tpsim::core

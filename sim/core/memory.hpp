@@ -9,6 +9,7 @@
 
 #include "kernel/memory_map.hpp"
 #include "sim/core/elf_loader.hpp"
+#include "sim/core/fault.hpp"
 
 namespace tpsim::core {
 
@@ -92,7 +93,9 @@ private:
         fault(addr, bytes, store);
     }
 
+    /// Throws the GuestFault of a failed access, with the exception a trap handler may take.
     [[noreturn]] void fault(uint32_t addr, uint32_t bytes, bool store) const;
+    GuestFault classify(uint32_t addr, uint32_t bytes, bool store) const;
 
     std::vector<Buffer> program_buffers_;
     std::vector<Region> program_regions_;  ///< ELF segments, by address

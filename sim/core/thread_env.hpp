@@ -16,8 +16,6 @@ namespace tpsim::core {
 namespace detail {
 
 constexpr uint32_t kExitSyscall = 93;  // a7 value of exit(a0), as in Linux/newlib
-constexpr uint32_t kCauseIllegal = 2;  // mcause values of the privileged spec
-constexpr uint32_t kCauseEcallM = 11;
 constexpr unsigned kA0 = 10, kA7 = 17, kSp = 2;
 
 struct NoRecorder {};
@@ -48,6 +46,8 @@ public:
         if (global_register >= kGlobalRegisters) [[unlikely]]
             bad_global_register(global_register);
         const uint32_t old = machine_.global_registers_[global_register]++;
+        // Register 0 hands out the work items (pixels): a new item starts.
+        if (global_register == 0) thread_.item_start = thread_.hart.instret;
         if constexpr (kRecord) record_->atomic_result = old;
         return old;
     }
@@ -64,16 +64,25 @@ public:
             if constexpr (kRecord) record_->exited = true;
             return;
         }
-        if (h.mtvec != 0) return isa::trap(h, detail::kCauseEcallM, 0);
+        if (h.mtvec != 0) return isa::trap(h, isa::cause::kEcallM, 0);
         unsupported_ecall(number);
     }
 
     // The rare and fault paths are out of line and take no pointer to the environment, so it
-    // stays in registers in the flattened step (see there).
-    [[noreturn, gnu::cold, gnu::noinline]] static void ebreak(isa::Hart&) {
+    // stays in registers in the flattened step (see there). With a trap handler installed
+    // (mtvec != 0) they trap as the privileged spec has it; without one they stop the thread.
+    [[gnu::cold, gnu::noinline]] static void ebreak(isa::Hart& h) {
+        if (h.mtvec != 0) return isa::trap(h, isa::cause::kBreakpoint, h.pc);
         throw GuestFault{FaultKind::Breakpoint, "stops the thread",
                          "remove the breakpoint (__builtin_trap / ebreak) or fix the failed "
                          "check that reached it"};
+    }
+
+    [[gnu::cold, gnu::noinline]] static void misaligned_jump(isa::Hart& h, uint32_t target) {
+        if (h.mtvec != 0) return isa::trap(h, isa::cause::kMisalignedFetch, target);
+        throw GuestFault{FaultKind::MisalignedJump,
+                         fmt::format("jumps to {:#010x}, which is not 4-byte aligned", target),
+                         "a return address or function pointer is corrupt (stack smashed?)"};
     }
 
     void illegal(isa::Hart& h, const isa::Decoded& d) { machine_.illegal(id_, h, d); }
@@ -121,18 +130,20 @@ private:
     if (id >= config_.threads) [[unlikely]]
         refuse_step(id);
     Thread& t = threads_[id];
-    if (t.state != ThreadState::Running || t.executed == config_.max_instructions) [[unlikely]]
+    const uint64_t left = instructions_left(t);
+    if (t.state != ThreadState::Running || left == 0) [[unlikely]]
         refuse_step(id);
-    // Stop at the instruction limit: the next call then reports the runaway at its fetch.
-    capacity = uint32_t(std::min<uint64_t>(capacity, config_.max_instructions - t.executed));
+    // Stop at the instruction limits: the next call then reports the runaway at its fetch.
+    capacity = uint32_t(std::min<uint64_t>(capacity, left));
     isa::Hart& h = t.hart;
     ThreadEnv<true> env(*this, id, out);
     // Locals, not members (as in run_quantum): stores through the hart's registers could alias
     // members, and the compiler would reload them every instruction.
     uint64_t* per_op = counters_.per_op.data();
-    const isa::Decoded* decoded = decoded_.data();
-    const uint32_t text_base = text_base_;
-    const uint32_t text_words = text_bytes_ / 4;
+    const isa::Decoded* decoded = decoded_.data() + entry_code_.first;
+    uint32_t first = entry_code_.first;
+    uint32_t text_base = entry_code_.base;
+    uint32_t text_words = entry_code_.words;
     uint32_t n = 0;  // records written
     const auto count = [&] {
         done = n;
@@ -144,23 +155,38 @@ private:
         for (;;) {
             pc = h.pc;
             // One compare checks range and alignment, as in run_quantum.
-            const uint32_t index = std::rotr(pc - text_base, 2);
-            if (index >= text_words) [[unlikely]]
-                fetch_fault(id, pc);
+            uint32_t index = std::rotr(pc - text_base, 2);
+            if (index >= text_words) [[unlikely]] {
+                const CodeRange* range = code_range_at(pc);
+                if (!range) fetch_fault(id, pc);
+                decoded = decoded_.data() + range->first;
+                first = range->first;
+                text_base = range->base;
+                text_words = range->words;
+                index = (pc - text_base) / 4;
+            }
             const isa::Decoded& d = decoded[index];
             ++per_op[size_t(d.op)];
             StepRecord& record = out[n];
             record = StepRecord{.pc = pc, .insn = &d};
             env.record_into(&record);
-            isa::execute(d, h, env);
+            isa::execute<ThreadEnv<true>, false>(d, h, env);
             record.taken = !record.exited && h.pc != pc + 4;
             // An exited thread's pc is parked outside the code, so it is not private either.
-            if (++n == capacity || !is_private(h, std::rotr(h.pc - text_base, 2), text_words))
+            if (++n == capacity ||
+                !is_private(h, std::rotr(h.pc - text_base, 2), text_words, first))
                 break;
         }
     } catch (const GuestFault& f) {
-        count();
-        fault(id, pc, f);
+        if (!take_trap(h, f)) {
+            count();
+            fault(id, pc, f);
+        }
+        // The access did not happen; the instruction ends the batch as a trap.
+        StepRecord& record = out[n++];
+        record.mem_bytes = 0;
+        record.mem_store = false;
+        record.taken = true;
     } catch (...) {
         count();
         throw;
@@ -168,8 +194,10 @@ private:
     count();
 }
 
-inline bool Machine::is_private(const isa::Hart& h, uint32_t index, uint32_t text_words) const {
-    if (index >= text_words) return false;
+inline bool Machine::is_private(const isa::Hart& h, uint32_t index, uint32_t words,
+                                uint32_t first) const {
+    if (index >= words) return false;
+    index += first;
     const Privacy privacy = privacy_[index];
     if (privacy == Privacy::Always || privacy == Privacy::Never) return privacy == Privacy::Always;
     // The local store, its overflow guard and the unmapped space above are private: an access

@@ -48,10 +48,14 @@ Profile profile_of(const timing::PcProfile& words, const core::Program& program)
     // Ordered maps: the roll-up must not depend on host hashing.
     std::map<uint32_t, FunctionProfile> functions;  // by symbol address; kUnknown at 0
     std::map<std::tuple<std::string, uint32_t, std::string>, LineProfile> lines;
+    std::vector<uint32_t> pcs;  // of each entry of words.words
+    for (const timing::TextRange& range : words.text)
+        for (uint32_t word = 0; word < range.words; ++word)
+            pcs.push_back(range.base + 4 * word);
     for (size_t index = 0; index < words.words.size(); ++index) {
         const ProfileCosts costs = costs_of(words.words[index]);
         if (!has_costs(costs)) continue;
-        const uint32_t pc = words.text_base + uint32_t(4 * index);
+        const uint32_t pc = pcs[index];
         profile.total += costs;
 
         const core::Symbol* symbol = program.function_at(pc);

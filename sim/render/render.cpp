@@ -22,9 +22,10 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 
 /// Runs the kernel on the functional machine over the image, in place.
 InstructionCounts run_functional(const core::Program& program, image::MemoryImage& image,
-                                 const timing::ChipConfig& chip, uint64_t max_instructions) {
-    const auto machine =
-        timing::make_machine(program, image.words, image.read_only_bytes(), chip, max_instructions);
+                                 const timing::ChipConfig& chip, uint64_t max_instructions,
+                                 uint64_t max_item_instructions) {
+    const auto machine = timing::make_machine(program, image.words, image.read_only_bytes(), chip,
+                                              max_instructions, max_item_instructions);
     machine->run();
     std::memcpy(image.words.data(), machine->memory().global().data(), image.bytes());
     return InstructionCounts::of(machine->counters());
@@ -51,11 +52,19 @@ bool Kernel::uses_bvh() const {
     return false;
 }
 
+uint64_t default_item_instructions(const scene::Scene& scene) {
+    const uint64_t per_ray = std::max<uint64_t>(uint64_t(1) << 22, 256 * scene.triangles.size());
+    const uint64_t rays =
+        uint64_t(scene.samples_per_pixel) * (1 + (scene.shadows ? scene.lights.size() : 0));
+    return per_ray * rays;
+}
+
 InstructionCounts run_kernel(const Kernel& kernel, Engine engine, image::MemoryImage& image,
-                             const timing::ChipConfig& chip, uint64_t max_instructions) {
+                             const timing::ChipConfig& chip, uint64_t max_instructions,
+                             uint64_t max_item_instructions) {
     switch (engine) {
     case Engine::functional:
-        return run_functional(kernel.program, image, chip, max_instructions);
+        return run_functional(kernel.program, image, chip, max_instructions, max_item_instructions);
     case Engine::native:
         run_native_twin(native_twin_of(kernel.elf), image.words,
                         chip.chip.num_tms * chip.chip.tps_per_tm, chip.chip.num_tms,
@@ -64,6 +73,7 @@ InstructionCounts run_kernel(const Kernel& kernel, Engine engine, image::MemoryI
     case Engine::timing: {
         TimingRunOptions watch;
         watch.max_instructions = max_instructions;
+        watch.max_item_instructions = max_item_instructions;
         return run_timing(kernel.program, image, chip, watch)->instructions;
     }
     }
@@ -94,19 +104,23 @@ RenderResult render(const RenderOptions& options) {
     result.threads = options.chip.chip.num_tms * options.chip.chip.tps_per_tm;
     result.image = image::build_memory_image(result.scene, bvh ? &*bvh : nullptr, result.threads);
 
+    const uint64_t item_limit = options.max_item_instructions != 0
+                                    ? options.max_item_instructions
+                                    : default_item_instructions(result.scene);
     start = std::chrono::steady_clock::now();
     if (options.engine == Engine::timing) {
-        result.timing = run_timing(
-            kernel.program, result.image, options.chip,
-            {options.max_instructions, uint64_t(result.scene.width) * result.scene.height,
-             options.on_progress, options.timeline_interval, options.profile});
+        result.timing =
+            run_timing(kernel.program, result.image, options.chip,
+                       {options.max_instructions, item_limit,
+                        uint64_t(result.scene.width) * result.scene.height, options.on_progress,
+                        options.timeline_interval, options.profile});
         if (options.profile)
             result.profile = std::make_shared<const Profile>(
                 profile_of(result.timing->chip->profile(), kernel.program));
         result.instructions = result.timing->instructions;
     } else {
         result.instructions = run_kernel(kernel, options.engine, result.image, options.chip,
-                                         options.max_instructions);
+                                         options.max_instructions, item_limit);
     }
     result.run_seconds = seconds_since(start);
     result.traversal = image::read_thread_stats(result.image.header, result.image.words.data());

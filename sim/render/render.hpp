@@ -65,7 +65,10 @@ struct RenderOptions {
     uint32_t image_width = 0, image_height = 0;
     timing::ChipConfig chip;                        ///< shape (TMs x TPs) and local-store size
     uint64_t max_instructions = uint64_t(1) << 32;  ///< per thread, for runaway kernels
-    ProgressCallback on_progress;  ///< Engine::timing calls it now and then while it runs
+    /// Per work item (core::MachineConfig::max_item_instructions), for runaway kernels;
+    /// 0: default_item_instructions(scene).
+    uint64_t max_item_instructions = 0;
+    ProgressCallback on_progress;    ///< Engine::timing calls it now and then while it runs
     /// Called with each of the scene's warnings (Scene::warnings) as soon as it is loaded.
     std::function<void(const std::string&)> on_warning;
     uint64_t timeline_interval = 0;  ///< Engine::timing: cycles per timeline row, 0 = adapt
@@ -99,11 +102,21 @@ struct RenderResult {
 /// also when a traversal stack overflowed.
 RenderResult render(const RenderOptions& options);
 
+/// The default limit on the instructions a thread retires on one work item (a pixel) before it
+/// is stopped as a runaway: 2^22 per ray, or 256 per triangle per ray above 16,384 triangles,
+/// times the rays of a pixel (samples x (1 + shadow rays)). The kernels here need ~2,000
+/// instructions per ray with the BVH and ~140 per triangle per ray by brute force, so no real
+/// render comes near it, while an endless loop on the default chip and scene (the Cornell box,
+/// 128 threads) is stopped after about 10^9 instructions (under a minute of cycle-level
+/// simulation).
+uint64_t default_item_instructions(const scene::Scene& scene);
+
 /// Runs a kernel over a memory image, in place, on the chosen engine with the chip's thread
 /// shape: the building block of render() and of tests that bring their own image (ray_query).
 /// Returns the instruction counts (zero for the native twin).
 InstructionCounts run_kernel(const Kernel& kernel, Engine engine, image::MemoryImage& image,
                              const timing::ChipConfig& chip,
-                             uint64_t max_instructions = uint64_t(1) << 32);
+                             uint64_t max_instructions = uint64_t(1) << 32,
+                             uint64_t max_item_instructions = 0);
 
 }  // namespace tpsim::render

@@ -10,7 +10,7 @@ std::shared_ptr<TimingRun> run_timing(const core::Program& program, image::Memor
                                       const TimingRunOptions& options) {
     auto run = std::make_shared<TimingRun>();
     run->machine = timing::make_machine(program, image.words, image.read_only_bytes(), chip,
-                                        options.max_instructions);
+                                        options.max_instructions, options.max_item_instructions);
     core::Machine& machine = *run->machine;
     run->source = std::make_unique<timing::MachineSource>(machine);
     timing::ChipLayout layout = chip_layout(image, machine);

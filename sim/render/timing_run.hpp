@@ -39,8 +39,8 @@ inline timing::ChipLayout chip_layout(const image::MemoryImage& image,
     const auto& segments = machine.program().segments;
     if (!segments.empty())
         layout.regions.push_back({"kernel_data", segments.front().vaddr, segments.back().end()});
-    layout.text_base = machine.text_base();
-    layout.text_words = machine.text_words();
+    for (const core::Machine::CodeRange& range : machine.code())
+        layout.text.push_back({range.base, range.words});
     const auto& header = image.header;
     layout.work_items =
         uint32_t(header.rays.count > 0 ? header.rays.count : header.framebuffer.count);
@@ -50,6 +50,7 @@ inline timing::ChipLayout chip_layout(const image::MemoryImage& image,
 /// How a cycle-level run is watched while it runs.
 struct TimingRunOptions {
     uint64_t max_instructions = uint64_t(1) << 32;  ///< per thread, for runaway kernels
+    uint64_t max_item_instructions = 0;             ///< per work item (0: no limit)
     uint64_t pixels = 0;                            ///< scales the progress reports (0: none)
     ProgressCallback on_progress;    ///< every timing::Chip::kProgressInterval cycles
     uint64_t timeline_interval = 0;  ///< cycles between timeline samples; 0: adapt (Timeline)

@@ -36,13 +36,18 @@ struct LevelTraffic {
     uint64_t moved_bytes = 0;    ///< bytes this level moved to or from the level below
 };
 
+/// Instruction words [base, base + 4 * words) of the kernel's code.
+struct TextRange {
+    uint32_t base = 0, words = 0;
+};
+
 /// What the chip is told about the program and the memory it runs over (not configuration:
 /// it follows from the scene and the kernel).
 struct ChipLayout {
     /// Non-overlapping, any order. Global accesses outside all of them count as "other".
     std::vector<Region> regions;
-    /// The kernel's text [text_base, text_base + 4 * text_words): one profile entry per word.
-    uint32_t text_base = 0, text_words = 0;
+    /// The kernel's code (its executable segments, by address): one profile entry per word.
+    std::vector<TextRange> text;
     /// Work items handed out by atomicinc on global register 0 (the pixel counter of the
     /// kernels): 0..work_items-1 are charged per item, others to WorkItemCosts::unassigned.
     uint32_t work_items = 0;
@@ -58,15 +63,21 @@ struct PcCounters {
     uint64_t dram_bytes = 0;                      ///< DRAM bytes moved for its misses and stores
 };
 
-/// Costs by instruction address: words[(pc - text_base) / 4].
+/// Costs by instruction address: one entry per word of each text range, the ranges' words
+/// back to back in `words`.
 struct PcProfile {
-    uint32_t text_base = 0;
+    std::vector<TextRange> text;
     std::vector<PcCounters> words;
 
     /// The counters of the instruction at `pc`, or nullptr outside the text.
     PcCounters* at(uint32_t pc) {
-        const uint32_t index = (pc - text_base) / 4;
-        return index < words.size() ? &words[index] : nullptr;
+        size_t first = 0;
+        for (const TextRange& range : text) {
+            const uint32_t index = (pc - range.base) / 4;
+            if (index < range.words) return &words[first + index];
+            first += range.words;
+        }
+        return nullptr;
     }
 };
 

@@ -213,7 +213,11 @@ Chip::Chip(const ChipConfig& config, InstructionSource& source, const ChipLayout
                             layout.regions[region_bounds_[r].index].name));
     other_region_ = uint8_t(layout.regions.size());
     work_items_.items.resize(layout.work_items);
-    if (layout.profile) profile_ = {layout.text_base, std::vector<PcCounters>(layout.text_words)};
+    if (layout.profile) {
+        profile_.text = layout.text;
+        for (const TextRange& range : layout.text)
+            profile_.words.resize(profile_.words.size() + range.words);
+    }
     const size_t regions = layout.regions.size() + 1;
     l1_traffic_.resize(regions);
     l2_traffic_.resize(regions);

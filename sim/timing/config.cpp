@@ -4,6 +4,7 @@
 #include <fmt/ranges.h>
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <bit>
 #include <charconv>
 #include <optional>
@@ -193,6 +194,38 @@ void validate(const ChipConfig& config) {
     check(config.dram.tRAS >= config.dram.tRCD,
           fmt::format("dram.tRAS = {} must be >= dram.tRCD = {}", config.dram.tRAS,
                       config.dram.tRCD));
+    const std::vector<HostBytes> parts = host_bytes(config);
+    uint64_t total = 0;
+    for (const HostBytes& part : parts)
+        total += part.bytes;
+    constexpr double kGiB = double(uint64_t(1) << 30);
+    check(total <= kMaxHostBytes,
+          fmt::format("the chip needs about {:.1f} GiB of host memory, more than the {:.0f} GiB "
+                      "tpsim allows; {:.1f} GiB of it is {}: reduce {}",
+                      double(total) / kGiB, double(kMaxHostBytes) / kGiB,
+                      double(parts.front().bytes) / kGiB, parts.front().part, parts.front().field));
+}
+
+std::vector<HostBytes> host_bytes(const ChipConfig& config) {
+    // Per cache line: its tag/state entry (Cache::Way: line, valid, LRU stamp).
+    constexpr uint64_t kPerLine = 16;
+    // Per thread: the machine's thread state and the timing model's run-ahead buffer
+    // (128 records of 24 bytes) and per-TP pipeline state, rounded up.
+    constexpr uint64_t kPerThread = 4096;
+    const uint64_t threads = uint64_t{config.chip.num_tms} * config.chip.tps_per_tm;
+    std::vector<HostBytes> parts = {
+        {uint64_t{config.chip.num_tms} * (config.l1.size_bytes / config.l1.line_bytes) * kPerLine,
+         "the L1 caches' tag and state arrays", "l1.size_bytes (or chip.num_tms)"},
+        {uint64_t{config.num_l2()} * (config.l2.size_bytes / config.l2.line_bytes) * kPerLine,
+         "the L2 caches' tag and state arrays", "l2.size_bytes (or chip.tms_per_l2)"},
+        {threads * config.tp.local_store_bytes, "the threads' local stores",
+         "tp.local_store_bytes (or chip.num_tms, chip.tps_per_tm)"},
+        {threads * kPerThread, "the threads' machine and pipeline state",
+         "chip.num_tms or chip.tps_per_tm"},
+    };
+    std::stable_sort(parts.begin(), parts.end(),
+                     [](const HostBytes& a, const HostBytes& b) { return a.bytes > b.bytes; });
+    return parts;
 }
 
 ChipConfig parse_config(std::string_view toml_text, std::string_view source_name,

@@ -140,8 +140,23 @@ ChipConfig parse_config(std::string_view toml_text, std::string_view source_name
                         const ChipConfig& base = {});
 /// Applies one "key.path=value" override (e.g. "l1.size_bytes=16384") with full validation.
 void apply_override(ChipConfig& config, std::string_view assignment);
-/// Checks every range and cross-field rule; throws ConfigError naming the first violation.
+/// Checks every range and cross-field rule, and that a run fits in kMaxHostBytes
+/// (host_bytes); throws ConfigError naming the first violation.
 void validate(const ChipConfig& config);
+
+/// The most host memory a chip may need (docs/hardware-model.md, "Chip and determinism"): more is
+/// refused up front instead of ending in std::bad_alloc after minutes of allocating.
+constexpr uint64_t kMaxHostBytes = uint64_t(8) << 30;
+
+/// One part of a chip's host memory, and the field that sizes it.
+struct HostBytes {
+    uint64_t bytes = 0;
+    const char* part = "";   ///< e.g. "the L1 caches' tag and state arrays"
+    const char* field = "";  ///< the config field to change, e.g. "l1.size_bytes"
+};
+/// The host memory a run of `config` needs for what grows with the chip: the caches' tag and
+/// state entries, every thread's local store, machine and run-ahead state; largest part first.
+std::vector<HostBytes> host_bytes(const ChipConfig& config);
 /// The resolved configuration as TOML, every key present, with its allowed range as a comment.
 std::string to_toml(const ChipConfig& config);
 /// One configurable field's resolved value.

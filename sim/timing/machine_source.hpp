@@ -31,11 +31,13 @@ inline core::MachineConfig machine_config_for(const ChipConfig& chip) {
 inline std::unique_ptr<core::Machine> make_machine(const core::Program& program,
                                                    std::span<const uint32_t> global,
                                                    uint64_t read_only_bytes, const ChipConfig& chip,
-                                                   uint64_t max_instructions) {
+                                                   uint64_t max_instructions,
+                                                   uint64_t max_item_instructions = 0) {
     core::MachineConfig config = machine_config_for(chip);
     config.global_bytes = uint32_t(global.size_bytes());
     config.read_only_global_bytes = uint32_t(read_only_bytes);
     config.max_instructions = max_instructions;
+    config.max_item_instructions = max_item_instructions;
     auto machine = std::make_unique<core::Machine>(program, config);
     std::memcpy(machine->memory().global().data(), global.data(), global.size_bytes());
     return machine;

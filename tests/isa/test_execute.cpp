@@ -143,14 +143,22 @@ TEST_CASE("branches and jumps", "[isa][execute]") {
     CHECK(h.pc == 0x1800);
     CHECK(h.reg[1] == 0x1004);
     // jalr clears bit 0 of the target and reads rs1 before writing rd (rd == rs1 here).
-    h.reg[5] = 0x2001;
-    run(h, env, encode(Op::jalr, x(5), x(5), 0, 2));
-    CHECK(h.pc == 0x2002);
+    h.reg[5] = 0x2002;
+    run(h, env, encode(Op::jalr, x(5), x(5), 0, 3));
+    CHECK(h.pc == 0x2004);
     CHECK(h.reg[5] == 0x1804);
+    // A target that is not 4-byte aligned: the jump does not complete (pc, rd, instret kept).
+    const uint64_t instret = h.instret;
+    h.reg[7] = 0x3002;
+    run(h, env, encode(Op::jalr, x(1), x(7), 0, 0));
+    CHECK(env.misaligned_jumps == 1);
+    CHECK(h.pc == 0x2004);
+    CHECK(h.reg[1] == 0x1004);
+    CHECK(h.instret == instret);
     run(h, env, encode(Op::lui, x(6), 0, 0, int32_t(0xabcde000)));
     CHECK(h.reg[6] == 0xabcd'e000);
     run(h, env, encode(Op::auipc, x(6), 0, 0, 0x1000));
-    CHECK(h.reg[6] == 0x2002 + 0x1000 + 4);  // pc of the auipc: 0x2006
+    CHECK(h.reg[6] == 0x2004 + 0x1000 + 4);  // pc of the auipc: 0x2008
 }
 
 TEST_CASE("CSR instructions", "[isa][execute][csr]") {

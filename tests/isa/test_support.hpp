@@ -63,7 +63,7 @@ inline uint32_t encode(Op op, uint32_t rd, uint32_t rs1, uint32_t rs2, int32_t i
 struct FakeEnv {
     std::vector<uint8_t> memory = std::vector<uint8_t>(4096);
     uint32_t globals[256] = {};
-    int ecalls = 0, ebreaks = 0, illegals = 0;
+    int ecalls = 0, ebreaks = 0, illegals = 0, misaligned_jumps = 0;
 
     template <class T> T load(uint32_t addr) {
         check(addr, sizeof(T));
@@ -94,6 +94,7 @@ struct FakeEnv {
     void ecall(Hart&) { ++ecalls; }
     void ebreak(Hart&) { ++ebreaks; }
     void illegal(Hart&, const Decoded&) { ++illegals; }
+    void misaligned_jump(Hart&, uint32_t) { ++misaligned_jumps; }
 
 private:
     void check(uint32_t addr, size_t size) const {

@@ -36,7 +36,7 @@ const core::Segment& text_of(const core::Program& program) {
 timing::PcProfile synthetic_profile(const core::Program& program) {
     const core::Segment& text = text_of(program);
     timing::PcProfile profile;
-    profile.text_base = text.vaddr;
+    profile.text = {{text.vaddr, text.memsz / 4}};
     profile.words.resize(text.memsz / 4);
     for (size_t i = 0; i < profile.words.size(); ++i) {
         timing::PcCounters& w = profile.words[i];
@@ -53,7 +53,7 @@ timing::PcProfile synthetic_profile(const core::Program& program) {
 timing::PcProfile single_word(const core::Program& program, uint32_t pc, uint64_t executions) {
     const core::Segment& text = text_of(program);
     timing::PcProfile profile;
-    profile.text_base = text.vaddr;
+    profile.text = {{text.vaddr, text.memsz / 4}};
     profile.words.resize(text.memsz / 4);
     timing::PcCounters& w = profile.words[(pc - text.vaddr) / 4];
     w.executions = executions;
@@ -184,6 +184,7 @@ TEST_CASE("profile: words without a function or a line go to one (unknown) entry
     const core::Program& program = tracer();
     timing::PcProfile words = single_word(program, program.entry, 5);
     // Past the end of the text: no symbol, no line.
+    words.text.front().words += 8;
     words.words.resize(words.words.size() + 8);
     words.words.back().executions = 11;
     words.words[words.words.size() - 2].executions = 13;

@@ -50,7 +50,7 @@ std::string fault_message(Machine& m) {
 TEST_CASE("instruction-class programs compute the expected results", "[sim][machine]") {
     // Each program exits with 0 when all of its checks pass, else with the failed check's number.
     for (const char* name :
-         {"alu", "muldiv", "branch", "loadstore", "float", "calls", "csr", "trap"}) {
+         {"alu", "muldiv", "branch", "loadstore", "float", "calls", "csr", "trap", "spec_traps"}) {
         INFO("program " << name);
         Machine m = machine_for(name);
         m.run();
@@ -131,6 +131,48 @@ TEST_CASE("faults name kind, thread, pc, function, instruction and a fix", "[sim
         CHECK(message.find('\n') == std::string::npos);
         CHECK(m.thread(0).state == ThreadState::Faulted);
     }
+}
+
+TEST_CASE("a jump to a misaligned target is reported at the jump", "[sim][machine]") {
+    for (const char* program : {"misaligned_jalr", "misaligned_branch"}) {
+        INFO("program " << program);
+        Machine m = machine_for(program);
+        const uint32_t jump = symbol_address(m.program(), "victim") + 12;  // after la (2) + addi
+        const std::string message = fault_message(m);
+        CHECK_THAT(message, Catch::StartsWith(fmt::format(
+                                "misaligned jump in thread 0 at pc {:#010x} (victim+0xc", jump)));
+        CHECK_THAT(message,
+                   Catch::Contains(fmt::format("jumps to {:#010x}, which is not 4-byte aligned",
+                                               std::string(program) == "misaligned_jalr"
+                                                   ? symbol_address(m.program(), "_start") + 2
+                                                   : jump + 6)));
+        CHECK(m.thread(0).hart.pc == jump);
+    }
+}
+
+TEST_CASE("only executable segments run, and a gap between them costs nothing", "[sim][machine]") {
+    Machine far = machine_for("segments_far_code");
+    REQUIRE(far.code().size() == 2);
+    CHECK(far.code()[1].base == 0x0ffff000);
+    // The decoded code is the two segments' words, not the 256 MiB between them.
+    CHECK(far.code()[0].words + far.code()[1].words < 64);
+    far.run();
+    CHECK(far.thread(0).exit_code == 0);
+
+    Machine data = machine_for("segments_data_code");
+    const std::string message = fault_message(data);
+    CHECK_THAT(message, Catch::StartsWith("jump outside the code in thread 0 at pc 0x00020000"));
+    CHECK_THAT(message, Catch::Contains("outside the code [0x00010000, 0x000100") &&
+                            Catch::Contains(") [0x0ffff000, 0x0ffff008)"));
+}
+
+TEST_CASE("a runaway work item stops at the item limit", "[sim][machine]") {
+    Machine m = machine_for("fault_endless", {.max_item_instructions = 500, .quantum = 64});
+    const std::string message = fault_message(m);
+    CHECK_THAT(message, Catch::StartsWith("instruction limit reached in thread 0 at pc 0x"));
+    CHECK_THAT(message, Catch::Contains("ran 500 instructions on one work item") &&
+                            Catch::Contains("--max-item-instructions"));
+    CHECK(m.thread(0).hart.instret == 500);
 }
 
 TEST_CASE("a jump to address 0 is reported as leaving the code", "[sim][machine]") {

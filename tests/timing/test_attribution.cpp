@@ -139,8 +139,8 @@ struct FramebufferRun {
         source = std::make_unique<MachineSource>(*machine);
         ChipLayout layout;
         layout.regions = {{"framebuffer", kFramebuffer, kFramebuffer + 12 * kPixels}};
-        layout.text_base = machine->text_base();
-        layout.text_words = machine->text_words();
+        for (const core::Machine::CodeRange& range : machine->code())
+            layout.text.push_back({range.base, range.words});
         layout.work_items = kPixels;
         chip = std::make_unique<Chip>(config, *source, layout);
         chip->run(10'000'000);
@@ -280,7 +280,8 @@ TEST_CASE("the profile by instruction adds up to the chip's totals", "[attributi
         const Chip& chip = *run.chip;
         const Stats s(chip);
         const PcProfile& profile = chip.profile();
-        REQUIRE(profile.words.size() == run.machine->text_words());
+        REQUIRE(run.machine->code().size() == 1);
+        REQUIRE(profile.words.size() == run.machine->code().front().words);
         PcCounters total;
         for (const PcCounters& pc : profile.words) {
             total.executions += pc.executions;

@@ -51,6 +51,20 @@ TEST_CASE("cross-field rules are checked", "[config]") {
     CHECK_THROWS_WITH(parse_config("[dram]\ntRAS = 5\n", "x.toml"), Contains("dram.tRAS"));
 }
 
+TEST_CASE("a chip that needs too much host memory is refused with the figure and the field",
+          "[config]") {
+    ChipConfig big;
+    big.chip.num_tms = 64;
+    big.l1.size_bytes = 1u << 30;
+    // 64 TMs x 2^24 lines x 16 bytes: 16 GiB of L1 tags.
+    CHECK(host_bytes(big).front().bytes == uint64_t(16) << 30);
+    CHECK_THROWS_WITH(validate(big), Contains("needs about 16.0 GiB of host memory") &&
+                                         Contains("reduce l1.size_bytes"));
+    big.chip.num_tms = 16;  // 4 GiB of L1 tags: allowed
+    CHECK_NOTHROW(validate(big));
+    CHECK_THROWS_WITH(apply_override(big, "chip.num_tms=64"), Contains("l1.size_bytes"));
+}
+
 TEST_CASE("overrides set one field with the same validation", "[config]") {
     ChipConfig c;
     apply_override(c, "l1.size_bytes=16384");
