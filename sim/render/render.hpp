@@ -68,7 +68,7 @@ struct RenderOptions {
     /// Per work item (core::MachineConfig::max_item_instructions), for runaway kernels;
     /// 0: default_item_instructions(scene).
     uint64_t max_item_instructions = 0;
-    ProgressCallback on_progress;    ///< Engine::timing calls it now and then while it runs
+    ProgressCallback on_progress;  ///< Engine::timing calls it now and then while it runs
     /// Called with each of the scene's warnings (Scene::warnings) as soon as it is loaded.
     std::function<void(const std::string&)> on_warning;
     uint64_t timeline_interval = 0;  ///< Engine::timing: cycles per timeline row, 0 = adapt
