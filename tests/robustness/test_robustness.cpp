@@ -13,6 +13,7 @@
 #include "sim/image/memory_image.hpp"
 #include "sim/render/render.hpp"
 #include "sim/scene/bvh.hpp"
+#include "tests/robustness/ray_query_run.hpp"
 
 using namespace tpsim;
 using trax::layout::Ray;
@@ -128,42 +129,18 @@ scene::Bvh bvh_for(const Mesh& mesh) {
 /// Runs ray_query over `rays` on both engines; REQUIREs that they agree bit for bit.
 Queries run_queries(const Mesh& mesh, const std::vector<Ray>& rays) {
     Queries q{bvh_for(mesh), {}};
-    scene::Scene s;
-    s.triangles = mesh;
-    s.materials.resize(1);
-    s.width = s.height = 1;
-    timing::ChipConfig chip;
-    chip.chip.num_tms = 1;
-    chip.chip.tps_per_tm = 4;
-    const auto kernel =
-        render::Kernel::load(std::filesystem::path(TPSIM_KERNEL_DIR) / "ray_query.elf");
-    // A finite instruction budget: a ray that hung the traversal would fail the run.
-    const uint64_t budget = 20000 * uint64_t(rays.size()) + 100000;
-
-    std::vector<RayResult> per_engine[2];
-    const render::Engine engines[2] = {render::Engine::functional, render::Engine::native};
-    for (int e = 0; e < 2; ++e) {
-        image::MemoryImage img = image::build_memory_image(s, &q.bvh, 4, rays);
-        render::run_kernel(kernel, engines[e], img, chip, budget);
-        per_engine[e] = image::read_ray_results(img.header, img.words.data());
-        const image::TraversalTotals totals =
-            image::read_thread_stats(img.header, img.words.data());
-        // A kRayFromSurface query whose first ray hit traces a second one.
-        size_t second_rays = 0;
-        for (size_t i = 0; i < rays.size(); ++i)
-            second_rays += (rays[i].mode & trax::layout::kRayFromSurface) &&
-                           per_engine[e][i].surface_triangle >= 0;
+    test::RayQueryRun run =
+        test::run_ray_query(mesh, q.bvh, rays, 20000 * uint64_t(rays.size()) + 100000);
+    // A kRayFromSurface query whose first ray hit traces a second one.
+    size_t second_rays = 0;
+    for (size_t i = 0; i < rays.size(); ++i)
+        second_rays +=
+            (rays[i].mode & trax::layout::kRayFromSurface) && run.results[i].surface_triangle >= 0;
+    for (const image::TraversalTotals& totals : run.totals) {
         CHECK(totals.rays() == rays.size() + second_rays);
         CHECK(totals.stack_overflows == 0);
     }
-    REQUIRE(per_engine[0].size() == rays.size());
-    REQUIRE(per_engine[1].size() == rays.size());
-    size_t differing = 0;
-    for (size_t i = 0; i < rays.size(); ++i)
-        differing += std::memcmp(&per_engine[0][i], &per_engine[1][i], sizeof(RayResult)) != 0;
-    INFO(differing << " of " << rays.size() << " results differ between simulator and twin");
-    REQUIRE(differing == 0);
-    q.results = std::move(per_engine[0]);
+    q.results = std::move(run.results);
     return q;
 }
 

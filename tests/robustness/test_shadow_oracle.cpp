@@ -22,6 +22,7 @@
 #include "sim/scene/bvh.hpp"
 #include "sim/scene/mesh_import.hpp"
 #include "sim/scene/procedural.hpp"
+#include "tests/robustness/ray_query_run.hpp"
 
 using namespace tpsim;
 namespace layout = trax::layout;
@@ -385,43 +386,21 @@ run_case(const Case& c, const std::vector<layout::Ray>& rays) {
     scene::BvhConfig config;
     config.traversal_stack_entries = layout::kTraversalStackEntries;
     const scene::Bvh bvh = scene::build_bvh(c.mesh, config);
-    scene::Scene s;
-    s.triangles = c.mesh;
-    s.materials.resize(1);
-    s.width = s.height = 1;
-    timing::ChipConfig chip;
-    chip.chip.num_tms = 1;
-    chip.chip.tps_per_tm = 4;
-    const auto kernel =
-        render::Kernel::load(std::filesystem::path(TPSIM_KERNEL_DIR) / "ray_query.elf");
-    const uint64_t budget = 60000 * uint64_t(rays.size()) + 100000;
-    std::vector<layout::RayResult> results[2];
+    const test::RayQueryRun run =
+        test::run_ray_query(c.mesh, bvh, rays, 60000 * uint64_t(rays.size()) + 100000);
+    for (const image::TraversalTotals& totals : run.totals)
+        CHECK(totals.stack_overflows == 0);
+    // The float triangles the kernel saw.
     std::vector<DTri> tris;
-    const render::Engine engines[2] = {render::Engine::functional, render::Engine::native};
-    for (int e = 0; e < 2; ++e) {
-        image::MemoryImage img = image::build_memory_image(s, &bvh, 4, rays);
-        render::run_kernel(kernel, engines[e], img, chip, budget);
-        results[e] = image::read_ray_results(img.header, img.words.data());
-        CHECK(image::read_thread_stats(img.header, img.words.data()).stack_overflows == 0);
-        if (e == 0) {  // the float triangles the kernel saw
-            const layout::SectionRef t = img.header.triangles;
-            for (int32_t i = 0; i < t.count; ++i) {
-                layout::Triangle record;
-                std::memcpy(&record, img.words.data() + t.addr + i * layout::kTriangleWords,
-                            sizeof record);
-                const auto v = [](const float* p) { return dvec3(p[0], p[1], p[2]); };
-                tris.push_back({v(record.v0), v(record.v1), v(record.v2)});
-            }
-        }
+    const layout::SectionRef t = run.image.header.triangles;
+    for (int32_t i = 0; i < t.count; ++i) {
+        layout::Triangle record;
+        std::memcpy(&record, run.image.words.data() + t.addr + i * layout::kTriangleWords,
+                    sizeof record);
+        const auto v = [](const float* p) { return dvec3(p[0], p[1], p[2]); };
+        tris.push_back({v(record.v0), v(record.v1), v(record.v2)});
     }
-    REQUIRE(results[0].size() == rays.size());
-    REQUIRE(results[1].size() == rays.size());
-    size_t differing = 0;
-    for (size_t i = 0; i < rays.size(); ++i)
-        differing += std::memcmp(&results[0][i], &results[1][i], sizeof(layout::RayResult)) != 0;
-    INFO(differing << " of " << rays.size() << " results differ between simulator and twin");
-    REQUIRE(differing == 0);
-    return {results[0], tris};
+    return {run.results, tris};
 }
 
 Tally check_case(const Case& c) {
