@@ -366,10 +366,12 @@ void check_gltf(const std::string& where, const std::string& bytes, bool binary)
 /// Every file assimp opens is read through tpsim's input check into memory, so a FIFO, a device
 /// or a huge file named inside a mesh (an OBJ's mtllib, a glTF buffer's uri) cannot block the
 /// import or exhaust memory. The first refusal is kept and reported once the import returns,
-/// even when assimp would carry on without the file.
+/// even when assimp would carry on without the file. The mesh file itself, already read and
+/// checked by import_mesh, is served from those bytes rather than read again.
 class CheckedIOSystem : public Assimp::DefaultIOSystem {
 public:
-    explicit CheckedIOSystem(std::string mesh) : mesh_(std::move(mesh)) {}
+    CheckedIOSystem(std::string mesh, const std::string& mesh_bytes)
+        : mesh_(std::move(mesh)), mesh_bytes_(mesh_bytes) {}
 
     // DefaultIOSystem::Exists opens the file, which blocks on a FIFO; stat does not.
     bool Exists(const char* file) const override {
@@ -380,16 +382,18 @@ public:
     Assimp::IOStream* Open(const char* file, const char* mode) override {
         // A missing file is assimp's to handle: an OBJ without its .mtl gets a default material.
         if (!Exists(file)) return nullptr;
-        std::string bytes;
+        std::string named_file;
         try {
             if (std::string_view(mode).find_first_of("wa+") != std::string_view::npos)
                 throw Error(fmt::format("{}: the importer tried to write '{}'", mesh_, file));
-            bytes = read_input_file(file, fmt::format("file named by mesh {}", mesh_),
-                                    kMaxMeshFileBytes);
+            if (file != mesh_)
+                named_file = read_input_file(file, fmt::format("file named by mesh {}", mesh_),
+                                             kMaxMeshFileBytes);
         } catch (const Error& e) {
             if (refusal_.empty()) refusal_ = e.what();
             return nullptr;
         }
+        const std::string& bytes = file == mesh_ ? mesh_bytes_ : named_file;
         auto* copy = new uint8_t[bytes.size()];
         std::copy(bytes.begin(), bytes.end(), copy);
         return new Assimp::MemoryIOStream(copy, bytes.size(), /*own=*/true);  // Close deletes it
@@ -399,6 +403,7 @@ public:
 
 private:
     std::string mesh_;
+    const std::string& mesh_bytes_;
     std::string refusal_;
 };
 
@@ -451,7 +456,7 @@ ImportedMesh import_mesh(const std::filesystem::path& path) {
 
     Assimp::Importer importer;
     keep_only_readers_for(importer, extension);
-    auto* io = new CheckedIOSystem(where);
+    auto* io = new CheckedIOSystem(where, bytes);
     importer.SetIOHandler(io);  // the importer owns it from here
     // ValidateDataStructure runs first so a malformed file is an error, not an ai_assert abort in
     // a later step (Debian's assimp keeps its asserts; e.g. an OFF file with a missing face list).
