@@ -287,10 +287,21 @@ struct BruteForce {
 /// (scene_layout.hpp), which matches the scene builder's depth contract. A full stack is counted,
 /// never silent: the far child is then dropped (the hit may be missed) and the host reports the
 /// overflow as an error.
-struct BvhTraversal {
+///
+/// The policy switches off the two things that make the traversal fast, for the course
+/// experiments that measure them (docs/course/experiments.md): `nearer_child_first = false`
+/// always descends into the left child first; `early_out = false` tests boxes against the ray's
+/// full extent instead of the closest hit so far and never skips a popped subtree. The tracer
+/// uses the defaults.
+struct TraversalPolicy {
+    bool nearer_child_first = true;
+    bool early_out = true;
+};
+
+template <TraversalPolicy kPolicy = TraversalPolicy{}> struct BasicBvhTraversal {
     int nodes, triangles;
 
-    static BvhTraversal from_scene() { return {trax_bvh(), trax_triangles()}; }
+    static BasicBvhTraversal from_scene() { return {trax_bvh(), trax_triangles()}; }
 
     template <bool kAnyHit> Hit trace(Vec3 origin, Vec3 dir, float t_max, RayStats& stats) const {
         Hit hit;
@@ -305,17 +316,19 @@ struct BvhTraversal {
         int node = nodes;
         ++stats.nodes_visited;
         if (!(slab_entry(node, origin, inverse, hit.t) <= hit.t)) return hit;
+        const auto box_limit = [&] { return kPolicy.early_out ? hit.t : t_max; };
         for (;;) {
             const int count = loadi(node, kNodeCount);
             const int first = loadi(node, kNodeFirst);
             if (count == 0) {
                 const int left = nodes + first * kBvhNodeWords, right = left + kBvhNodeWords;
                 stats.nodes_visited += 2;
-                const float t_left = slab_entry(left, origin, inverse, hit.t);
-                const float t_right = slab_entry(right, origin, inverse, hit.t);
-                const bool hit_left = t_left <= hit.t, hit_right = t_right <= hit.t;
+                const float limit = box_limit();
+                const float t_left = slab_entry(left, origin, inverse, limit);
+                const float t_right = slab_entry(right, origin, inverse, limit);
+                const bool hit_left = t_left <= limit, hit_right = t_right <= limit;
                 if (hit_left && hit_right) {
-                    const bool left_first = t_left <= t_right;
+                    const bool left_first = !kPolicy.nearer_child_first || t_left <= t_right;
                     node = left_first ? left : right;
                     if (depth == kTraversalStackEntries) {
                         ++stats.stack_overflows;
@@ -345,12 +358,13 @@ struct BvhTraversal {
             for (;;) {
                 if (depth == 0) return hit;
                 --depth;
-                if (stack_entry[depth] <= hit.t) break;
+                if (stack_entry[depth] <= box_limit()) break;
             }
             node = stack_node[depth];
         }
     }
 };
+using BvhTraversal = BasicBvhTraversal<>;
 
 /// A closest hit's surface point p = origin + t*dir and a bound on its distance from the
 /// triangle's plane. The offset below follows pbrt-v4 (Pharr, Jakob and Humphreys, "Physically
@@ -429,18 +443,68 @@ struct Shading {
     }
 };
 
-/// The shadow ray from surface point s to `target` (a light): any hit on the segment, from the
-/// origin offset towards the target.
-template <class Accel>
+/// The order the pixels are handed out in: work item n (from atomicinc) renders pixel_of(n).
+/// Threads that run at the same time take neighbouring items, so the order decides how close
+/// together their rays are (the packet idea on a thread-per-ray machine). Scanlines: row by
+/// row. Tiles: 8 x 8 blocks, row by row inside each. Morton: the Z-order curve over the
+/// smallest power-of-two square holding the image (items outside it render nothing).
+enum class PixelOrder { scanlines, tiles, morton };
+
+/// How render_image() works: the tracer uses the defaults; the rest are the course experiments'
+/// alternatives (docs/course/experiments.md). `any_hit_shadows = false` makes shadow rays find
+/// the closest blocker instead of stopping at the first.
+struct RenderPolicy {
+    PixelOrder order = PixelOrder::scanlines;
+    bool any_hit_shadows = true;
+};
+
+/// Work items to hand out for a width x height image in `order`.
+inline int work_items(int width, int height, PixelOrder order) {
+    if (order == PixelOrder::scanlines) return width * height;
+    if (order == PixelOrder::tiles) return ((width + 7) / 8) * ((height + 7) / 8) * 64;
+    int side = 1;
+    while (side < width || side < height)
+        side *= 2;
+    return side * side;
+}
+
+/// Every other bit of x, packed: the inverse of interleaving two coordinates.
+inline uint32_t even_bits(uint32_t x) {
+    x &= 0x55555555u;
+    x = (x | (x >> 1)) & 0x33333333u;
+    x = (x | (x >> 2)) & 0x0f0f0f0fu;
+    x = (x | (x >> 4)) & 0x00ff00ffu;
+    return (x | (x >> 8)) & 0x0000ffffu;
+}
+
+/// The pixel (y * width + x) work item `item` renders, or -1 when it lies outside the image
+/// (never for scanlines, whose items are the pixels).
+inline int pixel_of(int item, int width, int height, PixelOrder order) {
+    if (order == PixelOrder::scanlines) return item;
+    int x, y;
+    if (order == PixelOrder::tiles) {
+        const int tile = item / 64, tiles_across = (width + 7) / 8;
+        x = (tile % tiles_across) * 8 + item % 8;
+        y = (tile / tiles_across) * 8 + (item / 8) % 8;
+    } else {
+        x = static_cast<int>(even_bits(static_cast<uint32_t>(item)));
+        y = static_cast<int>(even_bits(static_cast<uint32_t>(item) >> 1));
+    }
+    return x < width && y < height ? y * width + x : -1;
+}
+
+/// The shadow ray from surface point s to `target` (a light), from the origin offset towards
+/// the target: any hit on the segment, or the closest when kAnyHit is false.
+template <class Accel, bool kAnyHit = true>
 Hit trace_to(const Accel& accel, const SurfacePoint& s, Vec3 target, RayStats& stats) {
     const Vec3 start = offset_origin(s, target - s.p);
-    return accel.template trace<true>(start, target - start, 1.0f, stats);
+    return accel.template trace<kAnyHit>(start, target - start, 1.0f, stats);
 }
 
 /// Lambert shading of the camera ray (origin, dir): ambient plus every point light facing the
 /// surface, with hard shadows (any-hit rays from the offset hit point) and 1/d^2 falloff when
 /// the scene asks for them.
-template <class Accel>
+template <RenderPolicy kPolicy = RenderPolicy{}, class Accel>
 Vec3 shade(const Shading& s, const Accel& accel, Vec3 origin, Vec3 dir, ThreadTotals& totals) {
     RayStats primary;
     const Hit hit = accel.template trace<false>(origin, dir, 3.0e38f, primary);
@@ -465,7 +529,8 @@ Vec3 shade(const Shading& s, const Accel& accel, Vec3 origin, Vec3 dir, ThreadTo
         if (s.flags & kFeatureLightFalloff) weight = weight / distance2;
         if (s.flags & kFeatureShadows) {
             RayStats shadow;
-            const Hit blocker = trace_to(accel, surface, light_position, shadow);
+            const Hit blocker =
+                trace_to<Accel, kPolicy.any_hit_shadows>(accel, surface, light_position, shadow);
             totals.add(shadow, true);
             if (blocker.triangle >= 0) continue;
         }
@@ -488,10 +553,12 @@ inline float unit_float(uint32_t bits) {
     return static_cast<float>(bits >> 8) * (1.0f / 16777216.0f);
 }
 
-/// The whole render kernel: pixels handed out with atomicinc(0); each gets samples_per_pixel
-/// camera rays (pixel centre for one sample, hashed jitter for more), shaded and averaged into
-/// the framebuffer as linear RGB; the thread's statistics record is written at the end.
-template <class Accel> void render_image(const Accel& accel) {
+/// The whole render kernel: pixels handed out with atomicinc(0) in the policy's order; each gets
+/// samples_per_pixel camera rays (pixel centre for one sample, hashed jitter for more), shaded
+/// and averaged into the framebuffer as linear RGB; the thread's statistics record is written
+/// at the end.
+template <RenderPolicy kPolicy = RenderPolicy{}, class Accel>
+void render_image(const Accel& accel) {
     const Shading s = Shading::from_scene();
     const int width = trax_image_width(), height = trax_image_height();
     const int samples = trax_samples_per_pixel();
@@ -504,7 +571,11 @@ template <class Accel> void render_image(const Accel& accel) {
     const float fwidth = static_cast<float>(width), fheight = static_cast<float>(height);
     ThreadTotals totals;
 
-    for (int pixel = atomicinc(0); pixel < width * height; pixel = atomicinc(0)) {
+    const int items = work_items(width, height, kPolicy.order);
+    for (int item = atomicinc(0); item < items; item = atomicinc(0)) {
+        const int pixel = pixel_of(item, width, height, kPolicy.order);
+        if constexpr (kPolicy.order != PixelOrder::scanlines)
+            if (pixel < 0) continue;
         const float x = static_cast<float>(pixel % width), y = static_cast<float>(pixel / width);
         Vec3 color{0.0f, 0.0f, 0.0f};
         for (int sample = 0; sample < samples; ++sample) {
@@ -515,7 +586,7 @@ template <class Accel> void render_image(const Accel& accel) {
                 jy = unit_float(hash(key + 1u));
             }
             const Vec3 dir = corner + right * ((x + jx) / fwidth) + down * ((y + jy) / fheight);
-            color = color + shade(s, accel, eye, dir, totals);
+            color = color + shade<kPolicy>(s, accel, eye, dir, totals);
         }
         color = color * (1.0f / static_cast<float>(samples));
         const int out = framebuffer + pixel * kPixelWords;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fnmatch.h>
 #include <ostream>
 #include <set>
 
@@ -478,7 +479,7 @@ std::string format_number(double value) {
     return fmt::format("{:.4g}", value);
 }
 
-Comparison compare(const std::vector<StatsFile>& runs) {
+Comparison compare(const std::vector<StatsFile>& runs, const std::vector<std::string>& keys) {
     Comparison c;
     for (const StatsFile& run : runs)
         c.runs.push_back(run.path.string());
@@ -489,8 +490,15 @@ Comparison compare(const std::vector<StatsFile>& runs) {
         keyed_section(runs, "FU utilisation", "chip/fu/", "/utilisation", Better::neutral));
     c.sections.push_back(traffic_section(runs));
     c.sections.push_back(per_ray_section(runs));
+    const auto unwanted = [&](const Row& row) {
+        return !has_any(row) ||
+               (!keys.empty() && std::none_of(keys.begin(), keys.end(), [&](const std::string& k) {
+                   return fnmatch(k.c_str(), row.key.c_str(), 0) == 0;
+               }));
+    };
     for (Section& section : c.sections)
-        std::erase_if(section.rows, [](const Row& row) { return !has_any(row); });
+        std::erase_if(section.rows, unwanted);
+    std::erase_if(c.sections, [](const Section& section) { return section.rows.empty(); });
     for (size_t i = 1; i < runs.size(); ++i)
         c.images.push_back(image_difference(runs[0], runs[i]));
     c.host = stat_row(runs, "host/run_seconds", Better::neutral);

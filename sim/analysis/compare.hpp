@@ -48,7 +48,9 @@ struct Comparison {
     Row host;  ///< host wall time of the kernel run: shown apart, never as a result
 };
 
-Comparison compare(const std::vector<StatsFile>& runs);
+/// `keys`, when not empty, keeps only the rows whose key matches one of these shell patterns
+/// ("chip/cycles", "region/bvh_nodes/*"), and the sections that still have rows.
+Comparison compare(const std::vector<StatsFile>& runs, const std::vector<std::string>& keys = {});
 
 enum class Format { text, markdown, csv, json };
 

@@ -23,6 +23,7 @@ struct CompareCommandOptions {
     std::string format = "text";
     std::string output;
     std::string html;
+    std::vector<std::string> keys;
 };
 
 int run_compare(const CompareCommandOptions& o) {
@@ -36,7 +37,7 @@ int run_compare(const CompareCommandOptions& o) {
     std::vector<analysis::StatsFile> runs;
     for (const std::string& file : o.files)
         runs.push_back(analysis::load_stats_file(file));
-    const analysis::Comparison comparison = analysis::compare(runs);
+    const analysis::Comparison comparison = analysis::compare(runs, o.keys);
     const analysis::Format format = o.format == "markdown" ? analysis::Format::markdown
                                     : o.format == "csv"    ? analysis::Format::csv
                                     : o.format == "json"   ? analysis::Format::json
@@ -69,6 +70,12 @@ Command add_compare_command(CLI::App& app) {
     command->add_option("--format", o->format, "Output format")
         ->check(CLI::IsMember({"text", "markdown", "csv", "json"}))
         ->capture_default_str();
+    command
+        ->add_option("--keys", o->keys,
+                     "Only these statistics (shell patterns, comma-separated), e.g. "
+                     "--keys 'chip/cycles,region/bvh_nodes/*'")
+        ->delimiter(',')
+        ->allow_extra_args(false);
     command->add_option("-o,--output", o->output, "Write the comparison here [default: stdout]");
     command->add_option("--html", o->html,
                         "Also write a self-contained HTML page with charts here");

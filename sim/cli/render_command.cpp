@@ -133,7 +133,9 @@ int run_render(const RenderCommandOptions& o) {
     if (!o.config.empty()) options.chip = timing::load_config(o.config);
     for (const std::string& assignment : o.overrides)
         timing::apply_override(options.chip, assignment);
-    options.bvh.builder = o.bvh == "binned" ? scene::BvhBuilder::binned : scene::BvhBuilder::sweep;
+    options.bvh.builder = o.bvh == "binned"   ? scene::BvhBuilder::binned
+                          : o.bvh == "median" ? scene::BvhBuilder::median
+                                              : scene::BvhBuilder::sweep;
     options.bvh.max_leaf_size = o.max_leaf;
 
     // Bad output paths are found now, not after a render that may take hours.
@@ -246,7 +248,7 @@ Command add_render_command(CLI::App& app) {
     command
         ->add_option("--bvh", o->bvh,
                      "BVH builder, used when the kernel traverses a BVH (TRAX_USES_BVH)")
-        ->check(CLI::IsMember({"sweep", "binned"}))
+        ->check(CLI::IsMember({"sweep", "binned", "median"}))
         ->capture_default_str();
     command->add_option("--max-leaf", o->max_leaf, "Most triangles in one BVH leaf")
         ->check(CLI::Range(1, 8))

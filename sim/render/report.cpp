@@ -288,7 +288,7 @@ nlohmann::ordered_json stats_document(const RenderOptions& options, const Render
     run["kernel"] = options.kernel.generic_string();
     run["kernel_name"] = options.kernel.stem().string();
     run["engine"] = engine_name(options.engine);
-    run["bvh_builder"] = options.bvh.builder == scene::BvhBuilder::binned ? "binned" : "sweep";
+    run["bvh_builder"] = scene::to_string(options.bvh.builder);
     run["max_leaf"] = options.bvh.max_leaf_size;
     run["width"] = r.scene.width;
     run["height"] = r.scene.height;

@@ -20,7 +20,9 @@ bool Aabb::contains(const Aabb& inner) const {
 }
 
 const char* to_string(BvhBuilder builder) {
-    return builder == BvhBuilder::binned ? "binned" : "sweep";
+    return builder == BvhBuilder::binned  ? "binned"
+           : builder == BvhBuilder::sweep ? "sweep"
+                                          : "median";
 }
 
 namespace {
@@ -124,6 +126,22 @@ protected:
     std::vector<BvhNode> nodes_;
     BvhStats stats_;
 };
+
+/// Half the range [begin, end) of `order` to each side of the object median by centroid on the
+/// widest centroid axis (index tie-break: deterministic); returns the middle.
+uint32_t partition_at_median(std::vector<uint32_t>& order, const std::vector<glm::vec3>& centroids,
+                             uint32_t begin, uint32_t end, const Box& centroid_bounds) {
+    const glm::vec3 extent = centroid_bounds.hi - centroid_bounds.lo;
+    const int axis =
+        extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
+    const uint32_t middle = begin + (end - begin) / 2;
+    std::nth_element(order.begin() + begin, order.begin() + middle, order.begin() + end,
+                     [&](uint32_t a, uint32_t b) {
+                         const float ca = centroids[a][axis], cb = centroids[b][axis];
+                         return ca < cb || (ca == cb && a < b);
+                     });
+    return middle;
+}
 
 /// Exact SAH over object splits: the triangles of every node are kept sorted by centroid on
 /// each axis (three index lists, presorted once, partitioned stably per node), and every split
@@ -282,9 +300,10 @@ private:
             nodes_[index].triangle_count = count;
             return;
         }
-        const uint32_t middle = choice.split.valid()
-                                    ? partition_by_bin(begin, end, centroid_bounds, choice.split)
-                                    : partition_at_median(begin, end, centroid_bounds);
+        const uint32_t middle =
+            choice.split.valid()
+                ? partition_by_bin(begin, end, centroid_bounds, choice.split)
+                : partition_at_median(order_, centroids_, begin, end, centroid_bounds);
         build_node(begin, middle, levels_left - 1);
         nodes_[index].right_child = uint32_t(nodes_.size());
         build_node(middle, end, levels_left - 1);
@@ -352,24 +371,50 @@ private:
         return uint32_t(middle - order_.begin());
     }
 
-    /// Fallback when binning cannot separate the triangles within the depth limit (e.g. all
-    /// centroids in one bin): half the triangles by centroid on the widest axis.
-    uint32_t partition_at_median(uint32_t begin, uint32_t end, const Box& centroid_bounds) {
-        const glm::vec3 extent = centroid_bounds.hi - centroid_bounds.lo;
-        const int axis =
-            extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
-        const uint32_t middle = begin + (end - begin) / 2;
-        std::nth_element(order_.begin() + begin, order_.begin() + middle, order_.begin() + end,
-                         [&](uint32_t a, uint32_t b) {
-                             const float ca = centroids_[a][axis], cb = centroids_[b][axis];
-                             return ca < cb || (ca == cb && a < b);
-                         });
-        return middle;
-    }
-
     uint32_t bins_;
     std::vector<uint32_t> order_;
     BinSweep sweep_;  // reused by every node
+};
+
+/// The median split, no SAH: every node with more than max_leaf_size triangles is halved at the
+/// object median. Halving keeps the depth at ceil(log2(n / max_leaf_size)), inside the stack
+/// contract whenever validate() accepted the soup.
+class MedianBuilder : BuilderBase {
+public:
+    MedianBuilder(std::span<const Triangle> triangles, const BvhConfig& config)
+        : BuilderBase(triangles, config) {
+        order_.resize(triangles.size());
+        for (uint32_t i = 0; i < order_.size(); ++i)
+            order_[i] = i;
+    }
+
+    Bvh build() {
+        nodes_.reserve(2 * order_.size());
+        build_node(0, uint32_t(order_.size()));
+        return Bvh{std::move(nodes_), std::move(order_), std::move(stats_)};
+    }
+
+private:
+    void build_node(uint32_t begin, uint32_t end) {
+        Box bounds, centroid_bounds;
+        for (uint32_t i = begin; i < end; ++i) {
+            bounds.grow(boxes_[order_[i]]);
+            centroid_bounds.grow(centroids_[order_[i]]);
+        }
+        const uint32_t index = emit_node(bounds);
+        if (end - begin <= config_.max_leaf_size) {
+            nodes_[index].first_triangle = begin;
+            nodes_[index].triangle_count = end - begin;
+            return;
+        }
+        const uint32_t middle =
+            partition_at_median(order_, centroids_, begin, end, centroid_bounds);
+        build_node(begin, middle);
+        nodes_[index].right_child = uint32_t(nodes_.size());
+        build_node(middle, end);
+    }
+
+    std::vector<uint32_t> order_;
 };
 
 /// Beyond this, box surface areas overflow float and the SAH becomes inf/inf.
@@ -445,8 +490,9 @@ double sah_cost(const Bvh& bvh) {
 Bvh build_bvh(std::span<const Triangle> triangles, const BvhConfig& config) {
     validate(triangles, config);
     const auto start = std::chrono::steady_clock::now();
-    Bvh bvh = config.builder == BvhBuilder::sweep ? SweepBuilder(triangles, config).build()
-                                                  : BinnedBuilder(triangles, config).build();
+    Bvh bvh = config.builder == BvhBuilder::sweep    ? SweepBuilder(triangles, config).build()
+              : config.builder == BvhBuilder::binned ? BinnedBuilder(triangles, config).build()
+                                                     : MedianBuilder(triangles, config).build();
     bvh.stats.build_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     fill_shape_stats(bvh, config.max_leaf_size, bvh.stats);

@@ -29,7 +29,9 @@ struct BvhNode {
     bool is_leaf() const { return triangle_count != 0; }
 };
 
-enum class BvhBuilder { binned, sweep };
+/// median: no SAH, the object median on the widest centroid axis until a node fits in a leaf;
+/// the baseline the SAH builders are measured against (docs/course/experiments.md).
+enum class BvhBuilder { binned, sweep, median };
 
 struct BvhConfig {
     BvhBuilder builder = BvhBuilder::sweep;

@@ -146,6 +146,24 @@ TEST_CASE("compare: region hit rates and per-ray figures are derived per run", "
     CHECK_FALSE(find_row(c, "region/camera/dram/writes"));
 }
 
+TEST_CASE("compare: --keys keeps only the matching rows and the sections that have any",
+          "[analysis]") {
+    const auto runs = load({"base.json", "brute.json"});
+    const Comparison all = compare(runs);
+    const Comparison some = compare(runs, {"chip/cycles", "region/camera/l1/*"});
+    REQUIRE(find_row(all, "chip/l2/hit_rate") != nullptr);
+    CHECK(find_row(some, "chip/l2/hit_rate") == nullptr);
+    REQUIRE(find_row(some, "chip/cycles") != nullptr);
+    CHECK(find_row(some, "chip/cycles")->values == find_row(all, "chip/cycles")->values);
+    CHECK(find_row(some, "region/camera/l1/reads") != nullptr);
+    CHECK(find_row(some, "region/camera/l2/reads") == nullptr);
+    std::vector<std::string> titles;
+    for (const Section& section : some.sections)
+        titles.push_back(section.title);
+    CHECK(titles == std::vector<std::string>{"summary", "traffic by region and level"});
+    CHECK(compare(runs, {"no/such/*"}).sections.empty());
+}
+
 TEST_CASE("compare: only the setup fields that differ are listed", "[analysis]") {
     const Comparison c = compare(load({"base.json", "faster.json", "brute.json"}));
     const SetupDifference* l1 = find_difference(c, "config l1.size_bytes");

@@ -259,3 +259,29 @@ TEST_CASE("Bunny: sweep SAH cost <= 32.5", "[bvh][bunny]") {
         CHECK(bvh.stats.sah_cost > 20.0);  // far below the state of the art would mean a wrong cost
     }
 }
+
+TEST_CASE("The median builder halves every node: valid, balanced, no better than the SAH",
+          "[bvh]") {
+    const auto triangles = random_soup(5000, 42);
+    for (uint32_t leaf : {1u, 2u, 4u, 8u}) {
+        INFO("leaf " << leaf);
+        const BvhConfig config{.builder = BvhBuilder::median, .max_leaf_size = leaf};
+        const Bvh bvh = build_bvh(triangles, config);
+        check_invariants(bvh, triangles, config);
+        CHECK(bvh.stats.sah_cost == Approx(sah_cost(bvh)));
+        // Halving 5000 until at most `leaf` remain: ceil(log2(ceil(5000 / leaf))) levels.
+        const auto expected_depth = uint32_t(std::ceil(std::log2(std::ceil(5000.0 / leaf))));
+        CHECK(bvh.stats.max_depth == expected_depth);
+        CHECK(bvh.stats.sah_cost > build_bvh(triangles, {.max_leaf_size = leaf}).stats.sah_cost);
+        const Bvh again = build_bvh(triangles, config);
+        CHECK(again.triangle_order == bvh.triangle_order);
+    }
+    // Always within the depth limit, even where the SAH builders must be forced: 1000
+    // triangles, leaves of 8, depth <= 7.
+    const auto strip = geometric_strip(1000);
+    const BvhConfig tight{.builder = BvhBuilder::median, .traversal_stack_entries = 7};
+    const Bvh shallow = build_bvh(strip, tight);
+    check_invariants(shallow, strip, tight);
+    CHECK(shallow.stats.depth_limited_nodes == 0);
+    CHECK(std::string(to_string(BvhBuilder::median)) == "median");
+}
