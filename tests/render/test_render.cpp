@@ -139,3 +139,9 @@ TEST_CASE("render: the course experiments' variants render the tracer's image at
             CHECK(variant.traversal.nodes_visited > tracer.traversal.nodes_visited);
     }
 }
+
+TEST_CASE("render: the adaptive super-sampling kernel renders like its twin", "[render]") {
+    const render::RenderResult adaptive = check_twin("cornell.toml", "adaptive.elf");
+    // One sample per pixel in the scene: every pixel takes it, none is refined.
+    CHECK(adaptive.traversal.primary_rays == 64 * 64);
+}
