@@ -175,13 +175,14 @@ Assignment load_assignment(const std::filesystem::path& toml_file) {
 
     if (auto* budgets = root.get("budgets"))
         for_each_table(r, *budgets, "budgets", [&](const toml::table& t, const std::string& entry) {
-            r.allow_keys(t, entry + ".", {"stat", "per", "max", "scenes", "hint"});
+            r.allow_keys(t, entry + ".", {"stat", "per", "max", "min", "scenes", "hint"});
             Budget b;
             const toml::node* stat = t.get("stat");
-            const toml::node* max = t.get("max");
-            if (!stat || !max) r.fail(t.source(), fmt::format("{} needs stat and max", entry));
+            if (!stat || !(t.get("max") || t.get("min")))
+                r.fail(t.source(), fmt::format("{} needs stat and max or min", entry));
             b.stat = r.string(*stat, entry + ".stat");
-            b.max = r.number(*max, entry + ".max", 0, 1e300);
+            if (auto* n = t.get("max")) b.max = r.number(*n, entry + ".max", 0, 1e300);
+            if (auto* n = t.get("min")) b.min = r.number(*n, entry + ".min", 0, 1e300);
             if (auto* n = t.get("per")) b.per = r.string(*n, entry + ".per");
             if (auto* n = t.get("hint")) b.hint = r.string(*n, entry + ".hint");
             if (auto* n = t.get("scenes")) {

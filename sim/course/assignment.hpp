@@ -18,11 +18,11 @@ struct AssignmentScene {
     std::filesystem::path reference;  ///< committed reference PNG (absolute once loaded)
 };
 
-/// A statistic of the render that must stay at or below a limit, e.g. cycles per pixel.
+/// A statistic of the render that must stay within limits, e.g. at most so many cycles per pixel.
 struct Budget {
     std::string stat;  ///< a statistics key (docs/statistics.md), e.g. "chip/cycles"
-    std::string per;   ///< divide by this key ("image/pixels", "rays/total"), or empty
-    double max = 0;
+    std::string per;   ///< divide by this key ("image/pixels", "chip/instructions"), or empty
+    std::optional<double> max, min;  ///< at least one is given
     std::vector<std::string> scenes;  ///< scene names it applies to; empty: every scene
     std::string hint;                 ///< what a failure likely means
     bool applies_to(std::string_view scene) const;

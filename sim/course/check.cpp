@@ -86,8 +86,8 @@ bool within(const ImageComparison& c, const ImageThresholds& t) {
 std::string likely_cause(const Rgb8& image, const Rgb8& ref, const ImageComparison& c,
                          const Assignment& a) {
     if (std::all_of(image.pixels.begin(), image.pixels.end(), [](uint8_t v) { return v == 0; }))
-        return "the image is black: did the kernel write the framebuffer (storef at "
-               "trax_framebuffer() + pixel * 3)?";
+        return "the image is black: does the kernel write the framebuffer (storef at "
+               "trax_framebuffer() + pixel * 3), and does it find anything to shade?";
     const struct {
         int mode;
         const char* cause;
@@ -169,10 +169,21 @@ void check_budgets(const Assignment& a, const AssignmentScene& scene,
         if (!b.applies_to(scene.name)) continue;
         const double divisor = b.per.empty() ? 1.0 : value(b.per);
         const double measured = divisor > 0 ? value(b.stat) / divisor : 0.0;
-        CheckResult r{scene.name, "budget", measured <= b.max, ""};
-        r.detail = fmt::format("{} {} {} {}", b.label(), number(measured),
-                               r.passed ? "<=" : ">", number(b.max));
-        if (!r.passed) r.detail += fmt::format(" allowed ({:.1f}x over)", measured / b.max);
+        const bool over = b.max && measured > *b.max, under = b.min && measured < *b.min;
+        CheckResult r{scene.name, "budget", !over && !under, ""};
+        if (over)
+            r.detail = fmt::format("{} {} > {} allowed ({} over)", b.label(), number(measured),
+                                   number(*b.max),
+                                   measured < 2 * *b.max
+                                       ? fmt::format("{:.1f}%", 100 * (measured / *b.max - 1))
+                                       : fmt::format("{:.1f}x", measured / *b.max));
+        else if (under)
+            r.detail = fmt::format("{} {} < {} required", b.label(), number(measured),
+                                   number(*b.min));
+        else
+            r.detail = fmt::format("{} {}{}{}", b.label(), number(measured),
+                                   b.min ? " >= " + number(*b.min) : "",
+                                   b.max ? " <= " + number(*b.max) : "");
         if (!r.passed && !b.hint.empty()) r.detail += " — " + b.hint;
         results.push_back(std::move(r));
     }
