@@ -42,10 +42,10 @@ int run_check(const CheckCommandOptions& o) {
     };
     options.on_progress = [&](const render::Progress& p) { progress.update(p); };
 
-    fmt::print("check    {}{} with {}\n", assignment.id,
-               assignment.title.empty() ? "" : " (" + assignment.title + ")", o.kernel);
     const course::CheckReport report = course::check(assignment, options);
     progress.clear();
+    fmt::print("check    {}{} with {}\n", assignment.id,
+               assignment.title.empty() ? "" : " (" + assignment.title + ")", o.kernel);
 
     std::string scene;
     size_t passed = 0;

@@ -77,6 +77,12 @@ Rgb8 transformed(const Rgb8& image, int mode) {
     return out;
 }
 
+bool one_colour(const Rgb8& image) {
+    for (size_t i = 3; i < image.pixels.size(); ++i)
+        if (image.pixels[i] != image.pixels[i % 3]) return false;
+    return true;
+}
+
 bool within(const ImageComparison& c, const ImageThresholds& t) {
     return c.psnr >= t.min_psnr && c.differing_share <= t.max_differing;
 }
@@ -88,6 +94,10 @@ std::string likely_cause(const Rgb8& image, const Rgb8& ref, const ImageComparis
     if (std::all_of(image.pixels.begin(), image.pixels.end(), [](uint8_t v) { return v == 0; }))
         return "the image is black: does the kernel write the framebuffer (storef at "
                "trax_framebuffer() + pixel * 3), and does it find anything to shade?";
+    if (one_colour(image))
+        return fmt::format("the image is one colour everywhere (sRGB {}, {}, {}): does any ray hit "
+                           "anything?",
+                           image.pixels[0], image.pixels[1], image.pixels[2]);
     const struct {
         int mode;
         const char* cause;
@@ -189,6 +199,18 @@ void check_budgets(const Assignment& a, const AssignmentScene& scene,
     }
 }
 
+/// Bad input is found before the first (slow) render.
+void check_inputs(const Assignment& a, const CheckOptions& o) {
+    render::Kernel::load(o.kernel);
+    if (o.update_references) return;
+    for (const AssignmentScene& scene : a.scenes)
+        if (!std::filesystem::is_regular_file(scene.reference))
+            throw Error(fmt::format(
+                "assignment {} has no reference image {} for scene '{}'; render it with the "
+                "reference solution: tpsim check {} --kernel SOLUTION.elf --update-references",
+                a.id, scene.reference.string(), scene.name, a.id));
+}
+
 }  // namespace
 
 ImageComparison compare_rgb8(const std::vector<uint8_t>& image, const std::vector<uint8_t>& ref,
@@ -227,14 +249,7 @@ bool CheckReport::passed() const {
 
 CheckReport check(const Assignment& a, const CheckOptions& o) {
     CheckReport report;
-    // Every reference is looked at before the first (slow) render.
-    if (!o.update_references)
-        for (const AssignmentScene& scene : a.scenes)
-            if (!std::filesystem::is_regular_file(scene.reference))
-                throw Error(fmt::format(
-                    "assignment {} has no reference image {} for scene '{}'; render it with the "
-                    "reference solution: tpsim check {} --kernel SOLUTION.elf --update-references",
-                    a.id, scene.reference.string(), scene.name, a.id));
+    check_inputs(a, o);
     for (size_t i = 0; i < a.scenes.size(); ++i) {
         const AssignmentScene& scene = a.scenes[i];
         if (o.on_scene) o.on_scene(i, scene);

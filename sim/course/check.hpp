@@ -51,7 +51,8 @@ ImageComparison compare_rgb8(const std::vector<uint8_t>& image, const std::vecto
                              int tolerance);
 
 /// Runs the whole check. Throws tpsim::Error for bad input (the kernel or a scene cannot be
-/// loaded, a reference is missing or unreadable); a kernel that faults or runs away fails.
+/// loaded, a reference is missing or unreadable), the kernel and the references before the
+/// first render; a kernel that faults or runs away fails.
 CheckReport check(const Assignment& assignment, const CheckOptions& options);
 
 }  // namespace tpsim::course
