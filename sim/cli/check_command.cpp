@@ -29,8 +29,8 @@ int run_check(const CheckCommandOptions& o) {
     const course::Assignment assignment = course::load_assignment(dir / "assignment.toml");
     std::error_code ec;
     if (!std::filesystem::is_directory(o.output_dir, ec))
-        throw Error(fmt::format("--output-dir '{}' is not a directory; create it first",
-                                o.output_dir));
+        throw Error(
+            fmt::format("--output-dir '{}' is not a directory; create it first", o.output_dir));
     course::CheckOptions options;
     options.kernel = o.kernel;
     options.output_dir = o.output_dir;
@@ -57,7 +57,7 @@ int run_check(const CheckCommandOptions& o) {
     for (const std::filesystem::path& file : report.files)
         fmt::print("wrote    {}\n", file.string());
     fmt::print("verdict  {} ({} of {} checks passed)\n",
-               !report.passed()       ? "FAIL"
+               !report.passed()      ? "FAIL"
                : o.update_references ? "references written"
                                      : "PASS",
                passed, report.results.size());

@@ -33,8 +33,9 @@ int main(int argc, char** argv) {
         return 2;
     }
     if (app.get_subcommands().empty()) {
-        fmt::print(stderr,
-                   "tpsim: give a subcommand: render, exec, compare, report or check (tpsim --help)\n");
+        fmt::print(
+            stderr,
+            "tpsim: give a subcommand: render, exec, compare, report or check (tpsim --help)\n");
         return 2;
     }
     int status = 0;

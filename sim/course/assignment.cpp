@@ -51,7 +51,8 @@ public:
         if (!node.is_number()) fail(node.source(), fmt::format("{} must be a number", name));
         const double v = node.is_integer() ? double(*node.value<int64_t>()) : *node.value<double>();
         if (!std::isfinite(v) || v < lo || v > hi)
-            fail(node.source(), fmt::format("{} must be in [{:g}, {:g}], got {:g}", name, lo, hi, v));
+            fail(node.source(),
+                 fmt::format("{} must be in [{:g}, {:g}], got {:g}", name, lo, hi, v));
         return v;
     }
 
@@ -80,9 +81,9 @@ private:
 
 void read_render(const Reader& r, const toml::table& t, const std::filesystem::path& dir,
                  Assignment& a) {
-    r.allow_keys(t, "render.",
-                 {"width", "height", "samples_per_pixel", "chip", "max_pixel_instructions",
-                  "slow_hint"});
+    r.allow_keys(
+        t, "render.",
+        {"width", "height", "samples_per_pixel", "chip", "max_pixel_instructions", "slow_hint"});
     if (auto* n = t.get("width")) a.width = uint32_t(r.integer(*n, "render.width", 1, 4096));
     if (auto* n = t.get("height")) a.height = uint32_t(r.integer(*n, "render.height", 1, 4096));
     if (auto* n = t.get("samples_per_pixel"))
@@ -97,7 +98,8 @@ void read_render(const Reader& r, const toml::table& t, const std::filesystem::p
 void read_image(const Reader& r, const toml::table& t, Assignment& a) {
     r.allow_keys(t, "image.", {"min_psnr", "tolerance", "max_differing", "brighter", "darker"});
     if (auto* n = t.get("min_psnr")) a.image.min_psnr = r.number(*n, "image.min_psnr", 0, 200);
-    if (auto* n = t.get("tolerance")) a.image.tolerance = int(r.integer(*n, "image.tolerance", 0, 255));
+    if (auto* n = t.get("tolerance"))
+        a.image.tolerance = int(r.integer(*n, "image.tolerance", 0, 255));
     if (auto* n = t.get("max_differing"))
         a.image.max_differing = r.number(*n, "image.max_differing", 0, 1);
     if (auto* n = t.get("brighter")) a.hints.brighter = r.string(*n, "image.brighter");
@@ -108,7 +110,8 @@ void read_image(const Reader& r, const toml::table& t, Assignment& a) {
 template <class F>
 void for_each_table(const Reader& r, const toml::node& node, const std::string& name, F&& f) {
     const toml::array* array = node.as_array();
-    if (!array) r.fail(node.source(), fmt::format("{} must be an array of tables ([[{}]])", name, name));
+    if (!array)
+        r.fail(node.source(), fmt::format("{} must be an array of tables ([[{}]])", name, name));
     for (size_t i = 0; i < array->size(); ++i) {
         const std::string entry = fmt::format("{}[{}]", name, i);
         f(r.table((*array)[i], entry), entry);
@@ -148,8 +151,8 @@ Assignment load_assignment(const std::filesystem::path& toml_file) {
 
     const toml::node* scenes = root.get("scenes");
     if (!scenes)
-        throw Error(fmt::format("{}: no [[scenes]]: an assignment renders at least one scene",
-                                source));
+        throw Error(
+            fmt::format("{}: no [[scenes]]: an assignment renders at least one scene", source));
     for_each_table(r, *scenes, "scenes", [&](const toml::table& t, const std::string& entry) {
         r.allow_keys(t, entry + ".", {"name", "file", "reference"});
         AssignmentScene s;
@@ -158,9 +161,9 @@ Assignment load_assignment(const std::filesystem::path& toml_file) {
             r.fail(t.source(), fmt::format("{} has no {} (required)", entry, key));
         };
         s.name = r.string(required("name"), entry + ".name");
-        if (std::find_if(a.scenes.begin(), a.scenes.end(),
-                         [&](const AssignmentScene& o) { return o.name == s.name; }) !=
-            a.scenes.end())
+        if (std::find_if(a.scenes.begin(), a.scenes.end(), [&](const AssignmentScene& o) {
+                return o.name == s.name;
+            }) != a.scenes.end())
             r.fail(t.get("name")->source(),
                    fmt::format("{}.name '{}' is used twice; give each scene its own name", entry,
                                s.name));
@@ -170,8 +173,8 @@ Assignment load_assignment(const std::filesystem::path& toml_file) {
         a.scenes.push_back(std::move(s));
     });
     if (a.scenes.empty())
-        throw Error(fmt::format("{}: scenes is empty: an assignment renders at least one scene",
-                                source));
+        throw Error(
+            fmt::format("{}: scenes is empty: an assignment renders at least one scene", source));
 
     if (auto* budgets = root.get("budgets"))
         for_each_table(r, *budgets, "budgets", [&](const toml::table& t, const std::string& entry) {
@@ -217,14 +220,15 @@ std::filesystem::path find_assignment(const std::filesystem::path& course_dir,
             ids.push_back(entry.path().filename().string());
     std::sort(ids.begin(), ids.end());
     for (const std::string& id : ids)
-        if (id == name || (id.starts_with(std::string(name) + "-") &&
-                           std::all_of(name.begin(), name.end(), [](char c) {
-                               return c >= '0' && c <= '9';
-                           }) && !name.empty()))
+        if (id == name ||
+            (id.starts_with(std::string(name) + "-") &&
+             std::all_of(name.begin(), name.end(), [](char c) { return c >= '0' && c <= '9'; }) &&
+             !name.empty()))
             return root / id;
     throw Error(fmt::format("no assignment '{}' in {}; the assignments are {} (give the folder "
                             "name or its number)",
-                            name, root.string(), ids.empty() ? "none" : fmt::format("{}", fmt::join(ids, ", "))));
+                            name, root.string(),
+                            ids.empty() ? "none" : fmt::format("{}", fmt::join(ids, ", "))));
 }
 
 }  // namespace tpsim::course

@@ -22,7 +22,7 @@ struct AssignmentScene {
 struct Budget {
     std::string stat;  ///< a statistics key (docs/statistics.md), e.g. "chip/cycles"
     std::string per;   ///< divide by this key ("image/pixels", "chip/instructions"), or empty
-    std::optional<double> max, min;  ///< at least one is given
+    std::optional<double> max, min;   ///< at least one is given
     std::vector<std::string> scenes;  ///< scene names it applies to; empty: every scene
     std::string hint;                 ///< what a failure likely means
     bool applies_to(std::string_view scene) const;
@@ -32,8 +32,8 @@ struct Budget {
 
 /// How close an image must be to its reference: both conditions hold for a pass.
 struct ImageThresholds {
-    double min_psnr = 30;     ///< dB over every channel of the 8-bit sRGB images
-    int tolerance = 4;        ///< a pixel differs when a channel is off by more than this /255
+    double min_psnr = 30;      ///< dB over every channel of the 8-bit sRGB images
+    int tolerance = 4;         ///< a pixel differs when a channel is off by more than this /255
     double max_differing = 0;  ///< share of pixels allowed to differ
 };
 
@@ -46,9 +46,9 @@ struct ImageHints {
 struct Assignment {
     std::string id;  ///< the folder name, e.g. "3-shadows"
     std::string title;
-    std::filesystem::path dir;  ///< the assignment's folder
-    uint32_t width = 0, height = 0;  ///< image size override (0: the scene's)
-    uint32_t samples_per_pixel = 0;  ///< override (0: the scene's)
+    std::filesystem::path dir;                         ///< the assignment's folder
+    uint32_t width = 0, height = 0;                    ///< image size override (0: the scene's)
+    uint32_t samples_per_pixel = 0;                    ///< override (0: the scene's)
     std::optional<std::filesystem::path> chip_config;  ///< absent: the default chip
     /// Instructions one pixel may take (the render's per-work-item limit); 0: tpsim's default.
     uint64_t max_pixel_instructions = 0;

@@ -34,8 +34,7 @@ Rgb8 read_rgb8(const std::filesystem::path& path, std::string_view what) {
     // Channels past the third (alpha) are dropped; a grey image is refused by the size check.
     if (in->spec().nchannels < 3 ||
         !in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, image.pixels.data()))
-        throw Error(fmt::format("cannot read {} {}: it must be an RGB image", what,
-                                path.string()));
+        throw Error(fmt::format("cannot read {} {}: it must be an RGB image", what, path.string()));
     return image;
 }
 
@@ -57,22 +56,22 @@ std::string percent(double share) {
     return share > 0 && share < 0.001 ? "<0.1%" : fmt::format("{:.1f}%", 100 * share);
 }
 
-/// The image as it would be with a simple mistake, to recognise that mistake.
-Rgb8 transformed(const Rgb8& image, int mode) {
+/// Simple mistakes that change a whole image in a way that can be undone.
+enum class Mistake { upside_down, mirrored, red_blue_exchanged };
+
+/// The image with `mistake` undone (each one is its own inverse).
+Rgb8 undone(const Rgb8& image, Mistake mistake) {
     Rgb8 out = image;
     for (int y = 0; y < image.height; ++y)
         for (int x = 0; x < image.width; ++x) {
-            const int sx = mode == 1 ? x : mode == 2 ? image.width - 1 - x : x;
-            const int sy = mode == 1 ? image.height - 1 - y : y;
+            const int sx = mistake == Mistake::mirrored ? image.width - 1 - x : x;
+            const int sy = mistake == Mistake::upside_down ? image.height - 1 - y : y;
             const uint8_t* s = &image.pixels[(size_t(sy) * image.width + sx) * 3];
             uint8_t* d = &out.pixels[(size_t(y) * image.width + x) * 3];
-            if (mode == 3) {  // red and blue exchanged
-                d[0] = s[2];
-                d[1] = s[1];
-                d[2] = s[0];
-            } else {
-                std::copy(s, s + 3, d);
-            }
+            const bool exchange = mistake == Mistake::red_blue_exchanged;
+            d[0] = s[exchange ? 2 : 0];
+            d[1] = s[1];
+            d[2] = s[exchange ? 0 : 2];
         }
     return out;
 }
@@ -99,15 +98,16 @@ std::string likely_cause(const Rgb8& image, const Rgb8& ref, const ImageComparis
                            "anything?",
                            image.pixels[0], image.pixels[1], image.pixels[2]);
     const struct {
-        int mode;
+        Mistake mistake;
         const char* cause;
     } mistakes[] = {
-        {1, "the image is upside down: row 0 of the framebuffer is the top of the image"},
-        {2, "the image is mirrored left to right: x grows to the right"},
-        {3, "red and blue are exchanged: a pixel is stored as R, G, B"},
+        {Mistake::upside_down,
+         "the image is upside down: row 0 of the framebuffer is the top of the image"},
+        {Mistake::mirrored, "the image is mirrored left to right: x grows to the right"},
+        {Mistake::red_blue_exchanged, "red and blue are exchanged: a pixel is stored as R, G, B"},
     };
     for (const auto& m : mistakes)
-        if (within(compare_rgb8(transformed(image, m.mode).pixels, ref.pixels, a.image.tolerance),
+        if (within(compare_rgb8(undone(image, m.mistake).pixels, ref.pixels, a.image.tolerance),
                    a.image))
             return m.cause;
     if (c.brighter_share >= 0.75 && !a.hints.brighter.empty())
@@ -182,14 +182,13 @@ void check_budgets(const Assignment& a, const AssignmentScene& scene,
         const bool over = b.max && measured > *b.max, under = b.min && measured < *b.min;
         CheckResult r{scene.name, "budget", !over && !under, ""};
         if (over)
-            r.detail = fmt::format("{} {} > {} allowed ({} over)", b.label(), number(measured),
-                                   number(*b.max),
-                                   measured < 2 * *b.max
-                                       ? fmt::format("{:.1f}%", 100 * (measured / *b.max - 1))
-                                       : fmt::format("{:.1f}x", measured / *b.max));
+            r.detail = fmt::format(
+                "{} {} > {} allowed ({} over)", b.label(), number(measured), number(*b.max),
+                measured < 2 * *b.max ? fmt::format("{:.1f}%", 100 * (measured / *b.max - 1))
+                                      : fmt::format("{:.1f}x", measured / *b.max));
         else if (under)
-            r.detail = fmt::format("{} {} < {} required", b.label(), number(measured),
-                                   number(*b.min));
+            r.detail =
+                fmt::format("{} {} < {} required", b.label(), number(measured), number(*b.min));
         else
             r.detail = fmt::format("{} {}{}{}", b.label(), number(measured),
                                    b.min ? " >= " + number(*b.min) : "",
@@ -241,10 +240,8 @@ ImageComparison compare_rgb8(const std::vector<uint8_t>& image, const std::vecto
 }
 
 bool CheckReport::passed() const {
-    return !results.empty() &&
-           std::all_of(results.begin(), results.end(), [](const CheckResult& r) {
-               return r.passed;
-           });
+    return !results.empty() && std::all_of(results.begin(), results.end(),
+                                           [](const CheckResult& r) { return r.passed; });
 }
 
 CheckReport check(const Assignment& a, const CheckOptions& o) {
@@ -286,12 +283,12 @@ CheckReport check(const Assignment& a, const CheckOptions& o) {
             const ImageComparison c = compare_rgb8(image.pixels, ref.pixels, a.image.tolerance);
             CheckResult r{scene.name, "image", within(c, a.image), ""};
             const std::string psnr =
-                c.identical ? "identical to the reference"
-                            : fmt::format("PSNR {:.1f} dB {} {:g} dB required", c.psnr,
-                                          c.psnr >= a.image.min_psnr ? ">=" : "<",
-                                          a.image.min_psnr);
-            r.detail = fmt::format("{}; {} of pixels differ by more than {}/255 ({} allowed)",
-                                   psnr, percent(c.differing_share), a.image.tolerance,
+                c.identical
+                    ? "identical to the reference"
+                    : fmt::format("PSNR {:.1f} dB {} {:g} dB required", c.psnr,
+                                  c.psnr >= a.image.min_psnr ? ">=" : "<", a.image.min_psnr);
+            r.detail = fmt::format("{}; {} of pixels differ by more than {}/255 ({} allowed)", psnr,
+                                   percent(c.differing_share), a.image.tolerance,
                                    percent(a.image.max_differing));
             if (!r.passed) r.detail += " — " + likely_cause(image, ref, c, a);
             report.results.push_back(std::move(r));

@@ -14,7 +14,7 @@ namespace tpsim::course {
 /// One verdict: an image comparison or a budget, on one scene.
 struct CheckResult {
     std::string scene;
-    std::string what;    ///< "image", "budget", "run"
+    std::string what;  ///< "image", "budget", "run"
     bool passed = false;
     std::string detail;  ///< the measurement against the requirement, and the likely cause
 };
@@ -40,9 +40,9 @@ struct CheckReport {
 
 /// How an image compares with its reference, on 8-bit sRGB values.
 struct ImageComparison {
-    double psnr = 0;                ///< dB; infinite when identical
-    double differing_share = 0;     ///< pixels with a channel off by more than the tolerance
-    double brighter_share = 0;      ///< of the differing pixels, those brighter than reference
+    double psnr = 0;             ///< dB; infinite when identical
+    double differing_share = 0;  ///< pixels with a channel off by more than the tolerance
+    double brighter_share = 0;   ///< of the differing pixels, those brighter than reference
     bool identical = false;
 };
 
