@@ -1,6 +1,5 @@
 // `tpsim render SCENE`: renders a scene with a kernel on the simulated chip (or its native twin),
 // writes the image and prints the statistics.
-#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -9,11 +8,11 @@
 #include <vector>
 
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include "sim/analysis/html_report.hpp"
 #include "sim/analysis/stats_file.hpp"
 #include "sim/cli/commands.hpp"
+#include "sim/cli/progress_line.hpp"
 #include "sim/core/error.hpp"
 #include "sim/render/heatmap.hpp"
 #include "sim/render/image_file.hpp"
@@ -37,51 +36,6 @@ std::filesystem::path resolve_kernel(const std::string& kernel) {
                                 kernel, built.string()));
     return built;
 }
-
-/// One self-overwriting status line on stderr while the chip model runs, redrawn at most ten
-/// times a second; nothing at all when stderr is not a terminal (logs, pipes, CI).
-class ProgressLine {
-public:
-    ProgressLine() : enabled_(isatty(STDERR_FILENO) == 1) {}
-    ~ProgressLine() { clear(); }
-    ProgressLine(const ProgressLine&) = delete;
-    ProgressLine& operator=(const ProgressLine&) = delete;
-
-    void update(const render::Progress& p) {
-        if (!enabled_ || p.pixels == 0) return;
-        const auto now = Clock::now();
-        const double share = double(p.pixels_done) / double(p.pixels);
-        if (!started_) {  // the first report starts the clock: scene loading is over by then
-            started_ = true;
-            start_ = last_ = now;
-            start_share_ = share;
-            return;
-        }
-        if (now - last_ < std::chrono::milliseconds(100)) return;
-        last_ = now;
-        const double elapsed = std::chrono::duration<double>(now - start_).count();
-        const std::string left =
-            share > start_share_
-                ? fmt::format("~{:.0f} s left", elapsed * (1 - share) / (share - start_share_))
-                : "estimating time left";
-        fmt::print(stderr, "\r{:5.1f}% of pixels, {} cycles, {}\033[K", 100 * share, p.cycles,
-                   left);
-        shown_ = true;
-    }
-
-    void clear() {
-        if (shown_) fmt::print(stderr, "\r\033[K");
-        shown_ = false;
-    }
-
-private:
-    using Clock = std::chrono::steady_clock;
-    bool enabled_;
-    bool started_ = false;
-    bool shown_ = false;
-    double start_share_ = 0;
-    Clock::time_point start_, last_;
-};
 
 struct RenderCommandOptions {
     std::string scene;

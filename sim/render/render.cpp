@@ -89,6 +89,7 @@ RenderResult render(const RenderOptions& options) {
             options.on_warning(warning);
     if (options.image_width != 0) result.scene.width = options.image_width;
     if (options.image_height != 0) result.scene.height = options.image_height;
+    if (options.samples_per_pixel != 0) result.scene.samples_per_pixel = options.samples_per_pixel;
     result.load_seconds = seconds_since(start);
 
     const Kernel kernel = Kernel::load(options.kernel);

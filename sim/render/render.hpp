@@ -63,7 +63,8 @@ struct RenderOptions {
     scene::BvhConfig bvh;
     /// Overrides the scene file's image size when non-zero (tests render small images).
     uint32_t image_width = 0, image_height = 0;
-    timing::ChipConfig chip;                        ///< shape (TMs x TPs) and local-store size
+    uint32_t samples_per_pixel = 0;  ///< overrides the scene file's samples when non-zero
+    timing::ChipConfig chip;         ///< shape (TMs x TPs) and local-store size
     uint64_t max_instructions = uint64_t(1) << 32;  ///< per thread, for runaway kernels
     /// Per work item (core::MachineConfig::max_item_instructions), for runaway kernels;
     /// 0: default_item_instructions(scene).

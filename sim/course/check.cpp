@@ -1,0 +1,304 @@
+#include "sim/course/check.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+
+#include <OpenImageIO/imageio.h>
+#include <fmt/format.h>
+
+#include "sim/core/error.hpp"
+#include "sim/core/fault.hpp"
+#include "sim/render/image_file.hpp"
+#include "sim/render/report.hpp"
+#include "sim/stats/registry.hpp"
+#include "sim/stats/thousands.hpp"
+#include "sim/timing/config.hpp"
+
+namespace tpsim::course {
+namespace {
+
+/// An 8-bit RGB image, as the references are stored.
+struct Rgb8 {
+    int width = 0, height = 0;
+    std::vector<uint8_t> pixels;  ///< row-major, row 0 at the top, 3 bytes a pixel
+};
+
+Rgb8 read_rgb8(const std::filesystem::path& path, std::string_view what) {
+    auto in = OIIO::ImageInput::open(path.string());
+    if (!in)
+        throw Error(fmt::format("cannot read {} {}: {}", what, path.string(), OIIO::geterror()));
+    Rgb8 image{in->spec().width, in->spec().height, {}};
+    image.pixels.resize(size_t(image.width) * image.height * 3);
+    // Channels past the third (alpha) are dropped; a grey image is refused by the size check.
+    if (in->spec().nchannels < 3 ||
+        !in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, image.pixels.data()))
+        throw Error(fmt::format("cannot read {} {}: it must be an RGB image", what, path.string()));
+    return image;
+}
+
+void write_rgb8(const std::filesystem::path& path, const Rgb8& image) {
+    auto out = OIIO::ImageOutput::create(path.string());
+    const OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
+    if (!out || !out->open(path.string(), spec) ||
+        !out->write_image(OIIO::TypeDesc::UINT8, image.pixels.data()) || !out->close())
+        throw Error(fmt::format("cannot write image '{}'", path.string()));
+}
+
+/// Counts as a person reads them: 1,234,567 for large values, 3 digits for small ones.
+std::string number(double v) {
+    if (std::abs(v) >= 1000) return stats::with_thousands(fmt::format("{:.0f}", v));
+    return fmt::format("{:.3g}", v);
+}
+
+std::string percent(double share) {
+    return share > 0 && share < 0.001 ? "<0.1%" : fmt::format("{:.1f}%", 100 * share);
+}
+
+/// Simple mistakes that change a whole image in a way that can be undone.
+enum class Mistake { upside_down, mirrored, red_blue_exchanged };
+
+/// The image with `mistake` undone (each one is its own inverse).
+Rgb8 undone(const Rgb8& image, Mistake mistake) {
+    Rgb8 out = image;
+    for (int y = 0; y < image.height; ++y)
+        for (int x = 0; x < image.width; ++x) {
+            const int sx = mistake == Mistake::mirrored ? image.width - 1 - x : x;
+            const int sy = mistake == Mistake::upside_down ? image.height - 1 - y : y;
+            const uint8_t* s = &image.pixels[(size_t(sy) * image.width + sx) * 3];
+            uint8_t* d = &out.pixels[(size_t(y) * image.width + x) * 3];
+            const bool exchange = mistake == Mistake::red_blue_exchanged;
+            d[0] = s[exchange ? 2 : 0];
+            d[1] = s[1];
+            d[2] = s[exchange ? 0 : 2];
+        }
+    return out;
+}
+
+bool one_colour(const Rgb8& image) {
+    for (size_t i = 3; i < image.pixels.size(); ++i)
+        if (image.pixels[i] != image.pixels[i % 3]) return false;
+    return true;
+}
+
+bool within(const ImageComparison& c, const ImageThresholds& t) {
+    return c.psnr >= t.min_psnr && c.differing_share <= t.max_differing;
+}
+
+/// What the failed image most likely shows, in words: a simple mistake that would explain it
+/// whole, or the assignment's hint for pixels that are too bright or too dark.
+std::string likely_cause(const Rgb8& image, const Rgb8& ref, const ImageComparison& c,
+                         const Assignment& a) {
+    if (std::all_of(image.pixels.begin(), image.pixels.end(), [](uint8_t v) { return v == 0; }))
+        return "the image is black: does the kernel write the framebuffer (storef at "
+               "trax_framebuffer() + pixel * 3), and does it find anything to shade?";
+    if (one_colour(image))
+        return fmt::format("the image is one colour everywhere (sRGB {}, {}, {}): does any ray hit "
+                           "anything?",
+                           image.pixels[0], image.pixels[1], image.pixels[2]);
+    const struct {
+        Mistake mistake;
+        const char* cause;
+    } mistakes[] = {
+        {Mistake::upside_down,
+         "the image is upside down: row 0 of the framebuffer is the top of the image"},
+        {Mistake::mirrored, "the image is mirrored left to right: x grows to the right"},
+        {Mistake::red_blue_exchanged, "red and blue are exchanged: a pixel is stored as R, G, B"},
+    };
+    for (const auto& m : mistakes)
+        if (within(compare_rgb8(undone(image, m.mistake).pixels, ref.pixels, a.image.tolerance),
+                   a.image))
+            return m.cause;
+    if (c.brighter_share >= 0.75 && !a.hints.brighter.empty())
+        return fmt::format("most of them are brighter than the reference: {}", a.hints.brighter);
+    if (c.brighter_share <= 0.25 && !a.hints.darker.empty())
+        return fmt::format("most of them are darker than the reference: {}", a.hints.darker);
+    return fmt::format("{} of them brighter, {} darker than the reference; see the difference "
+                       "image",
+                       percent(c.brighter_share), percent(1 - c.brighter_share));
+}
+
+/// The difference image: matching pixels as a dim grey copy of the reference, differing ones
+/// red where the kernel's image is brighter and blue where it is darker, brighter the larger
+/// the difference.
+Rgb8 difference_image(const Rgb8& image, const Rgb8& ref, int tolerance) {
+    Rgb8 out{ref.width, ref.height, std::vector<uint8_t>(ref.pixels.size())};
+    for (size_t p = 0; p < ref.pixels.size(); p += 3) {
+        int largest = 0, signed_sum = 0, grey = 0;
+        for (int c = 0; c < 3; ++c) {
+            const int d = int(image.pixels[p + c]) - int(ref.pixels[p + c]);
+            largest = std::max(largest, std::abs(d));
+            signed_sum += d;
+            grey += ref.pixels[p + c];
+        }
+        uint8_t* d = &out.pixels[p];
+        if (largest <= tolerance) {
+            d[0] = d[1] = d[2] = uint8_t(grey / 3 / 4);
+            continue;
+        }
+        const uint8_t strength = uint8_t(std::min(255, 128 + largest));
+        d[0] = signed_sum > 0 ? strength : 0;
+        d[1] = 0;
+        d[2] = signed_sum > 0 ? 0 : strength;
+    }
+    return out;
+}
+
+render::RenderOptions render_options(const Assignment& a, const AssignmentScene& scene,
+                                     const CheckOptions& o) {
+    render::RenderOptions r;
+    r.scene = scene.file;
+    r.kernel = o.kernel;
+    r.engine = render::Engine::timing;
+    r.image_width = a.width;
+    r.image_height = a.height;
+    r.samples_per_pixel = a.samples_per_pixel;
+    if (a.chip_config) r.chip = timing::load_config(a.chip_config->string());
+    r.max_item_instructions = a.max_pixel_instructions;
+    r.on_progress = o.on_progress;
+    return r;
+}
+
+/// The budgets of one scene, checked against its statistics.
+void check_budgets(const Assignment& a, const AssignmentScene& scene,
+                   const render::RenderResult& result, std::vector<CheckResult>& results) {
+    stats::Registry registry;
+    render::register_stats(result, registry);
+    const stats::Snapshot snapshot(registry);
+    const auto value = [&](const std::string& key) {
+        try {
+            return snapshot.value(key);
+        } catch (const std::out_of_range&) {
+            throw Error(fmt::format("{}: budget statistic '{}' is not a statistic of this render; "
+                                    "see docs/statistics.md for the keys",
+                                    (a.dir / "assignment.toml").string(), key));
+        }
+    };
+    for (const Budget& b : a.budgets) {
+        if (!b.applies_to(scene.name)) continue;
+        const double divisor = b.per.empty() ? 1.0 : value(b.per);
+        const double measured = divisor > 0 ? value(b.stat) / divisor : 0.0;
+        const bool over = b.max && measured > *b.max, under = b.min && measured < *b.min;
+        CheckResult r{scene.name, "budget", !over && !under, ""};
+        if (over)
+            r.detail = fmt::format(
+                "{} {} > {} allowed ({} over)", b.label(), number(measured), number(*b.max),
+                measured < 2 * *b.max ? fmt::format("{:.1f}%", 100 * (measured / *b.max - 1))
+                                      : fmt::format("{:.1f}x", measured / *b.max));
+        else if (under)
+            r.detail =
+                fmt::format("{} {} < {} required", b.label(), number(measured), number(*b.min));
+        else
+            r.detail = fmt::format("{} {}{}{}", b.label(), number(measured),
+                                   b.min ? " >= " + number(*b.min) : "",
+                                   b.max ? " <= " + number(*b.max) : "");
+        if (!r.passed && !b.hint.empty()) r.detail += " — " + b.hint;
+        results.push_back(std::move(r));
+    }
+}
+
+/// Bad input is found before the first (slow) render.
+void check_inputs(const Assignment& a, const CheckOptions& o) {
+    render::Kernel::load(o.kernel);
+    if (o.update_references) return;
+    for (const AssignmentScene& scene : a.scenes)
+        if (!std::filesystem::is_regular_file(scene.reference))
+            throw Error(fmt::format(
+                "assignment {} has no reference image {} for scene '{}'; render it with the "
+                "reference solution: tpsim check {} --kernel SOLUTION.elf --update-references",
+                a.id, scene.reference.string(), scene.name, a.id));
+}
+
+}  // namespace
+
+ImageComparison compare_rgb8(const std::vector<uint8_t>& image, const std::vector<uint8_t>& ref,
+                             int tolerance) {
+    ImageComparison c;
+    double squared = 0;
+    uint64_t differing = 0, brighter = 0;
+    for (size_t p = 0; p + 2 < ref.size(); p += 3) {
+        int largest = 0, signed_sum = 0;
+        for (int ch = 0; ch < 3; ++ch) {
+            const int d = int(image[p + ch]) - int(ref[p + ch]);
+            squared += double(d) * d;
+            largest = std::max(largest, std::abs(d));
+            signed_sum += d;
+        }
+        if (largest > tolerance) {
+            ++differing;
+            brighter += signed_sum > 0;
+        }
+    }
+    const double samples = double(ref.size());
+    const double rmse = samples > 0 ? std::sqrt(squared / samples) / 255.0 : 0.0;
+    c.identical = squared == 0;
+    c.psnr = c.identical ? std::numeric_limits<double>::infinity() : 20 * std::log10(1 / rmse);
+    c.differing_share = samples > 0 ? double(differing) / (samples / 3) : 0.0;
+    c.brighter_share = differing > 0 ? double(brighter) / double(differing) : 0.0;
+    return c;
+}
+
+bool CheckReport::passed() const {
+    return !results.empty() && std::all_of(results.begin(), results.end(),
+                                           [](const CheckResult& r) { return r.passed; });
+}
+
+CheckReport check(const Assignment& a, const CheckOptions& o) {
+    CheckReport report;
+    check_inputs(a, o);
+    for (size_t i = 0; i < a.scenes.size(); ++i) {
+        const AssignmentScene& scene = a.scenes[i];
+        if (o.on_scene) o.on_scene(i, scene);
+        render::RenderResult result;
+        try {
+            result = render::render(render_options(a, scene, o));
+        } catch (const core::Fault& fault) {
+            // The kernel's own mistake: the assignment fails, with the simulator's words.
+            const bool runaway = fault.kind() == core::FaultKind::InstructionLimit;
+            std::string detail = fmt::format("the kernel stopped: {}", fault.what());
+            if (runaway && a.max_pixel_instructions != 0)
+                detail = fmt::format("a pixel took more than {} instructions{}; {}",
+                                     number(double(a.max_pixel_instructions)),
+                                     a.slow_hint.empty() ? "" : " — " + a.slow_hint, fault.what());
+            report.results.push_back({scene.name, "run", false, detail});
+            continue;
+        }
+        const std::string stem = fmt::format("check-{}-{}", a.id, scene.name);
+        const std::filesystem::path image_path =
+            o.update_references ? scene.reference : o.output_dir / (stem + ".png");
+        render::write_image(image_path, result.rgb, result.scene.width, result.scene.height);
+        report.files.push_back(image_path);
+        if (o.update_references) {
+            report.results.push_back({scene.name, "image", true,
+                                      fmt::format("reference written: {}", image_path.string())});
+        } else {
+            const Rgb8 image = read_rgb8(image_path, "the kernel's image");
+            const Rgb8 ref = read_rgb8(scene.reference, "reference image");
+            if (ref.width != image.width || ref.height != image.height)
+                throw Error(fmt::format("reference image {} is {}x{} but the assignment renders "
+                                        "{}x{}; render it again with --update-references",
+                                        scene.reference.string(), ref.width, ref.height,
+                                        image.width, image.height));
+            const ImageComparison c = compare_rgb8(image.pixels, ref.pixels, a.image.tolerance);
+            CheckResult r{scene.name, "image", within(c, a.image), ""};
+            const std::string psnr =
+                c.identical
+                    ? "identical to the reference"
+                    : fmt::format("PSNR {:.1f} dB {} {:g} dB required", c.psnr,
+                                  c.psnr >= a.image.min_psnr ? ">=" : "<", a.image.min_psnr);
+            r.detail = fmt::format("{}; {} of pixels differ by more than {}/255 ({} allowed)", psnr,
+                                   percent(c.differing_share), a.image.tolerance,
+                                   percent(a.image.max_differing));
+            if (!r.passed) r.detail += " — " + likely_cause(image, ref, c, a);
+            report.results.push_back(std::move(r));
+            const std::filesystem::path diff = o.output_dir / (stem + ".diff.png");
+            write_rgb8(diff, difference_image(image, ref, a.image.tolerance));
+            report.files.push_back(diff);
+        }
+        check_budgets(a, scene, result, report.results);
+    }
+    return report;
+}
+
+}  // namespace tpsim::course

@@ -1,0 +1,58 @@
+// `tpsim check`: renders a kernel on an assignment's scenes on the simulated chip, compares each
+// image with the committed reference, checks the budgets, and says what passed and why not.
+#pragma once
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "sim/course/assignment.hpp"
+#include "sim/render/render.hpp"
+
+namespace tpsim::course {
+
+/// One verdict: an image comparison or a budget, on one scene.
+struct CheckResult {
+    std::string scene;
+    std::string what;  ///< "image", "budget", "run"
+    bool passed = false;
+    std::string detail;  ///< the measurement against the requirement, and the likely cause
+};
+
+struct CheckOptions {
+    std::filesystem::path kernel;
+    std::filesystem::path output_dir = ".";  ///< the kernel's images and the difference images
+    /// Write the kernel's images as the assignment's references instead of comparing (for the
+    /// instructor, with the reference solution).
+    bool update_references = false;
+    /// Called when a scene starts rendering (index from 0) ...
+    std::function<void(size_t index, const AssignmentScene&)> on_scene;
+    /// ... and while it renders on the chip model.
+    render::ProgressCallback on_progress;
+};
+
+struct CheckReport {
+    std::vector<CheckResult> results;
+    /// Files written, in order: the kernel's image and the difference image of each scene.
+    std::vector<std::filesystem::path> files;
+    bool passed() const;
+};
+
+/// How an image compares with its reference, on 8-bit sRGB values.
+struct ImageComparison {
+    double psnr = 0;             ///< dB; infinite when identical
+    double differing_share = 0;  ///< pixels with a channel off by more than the tolerance
+    double brighter_share = 0;   ///< of the differing pixels, those brighter than reference
+    bool identical = false;
+};
+
+/// Compares two 8-bit RGB images of the same size (row-major, 3 bytes a pixel).
+ImageComparison compare_rgb8(const std::vector<uint8_t>& image, const std::vector<uint8_t>& ref,
+                             int tolerance);
+
+/// Runs the whole check. Throws tpsim::Error for bad input (the kernel or a scene cannot be
+/// loaded, a reference is missing or unreadable), the kernel and the references before the
+/// first render; a kernel that faults or runs away fails.
+CheckReport check(const Assignment& assignment, const CheckOptions& options);
+
+}  // namespace tpsim::course
