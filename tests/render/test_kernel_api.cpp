@@ -5,8 +5,10 @@
 #include <vector>
 
 #include <catch2/catch.hpp>
+#include <fmt/format.h>
 
 #include "sim/core/error.hpp"
+#include "sim/render/profile.hpp"
 #include "sim/render/render.hpp"
 #include "sim/render/report.hpp"
 #include "sim/render/timing_run.hpp"
@@ -31,7 +33,8 @@ struct Shape {
 // One thread, one TM, several TMs, odd TP counts.
 constexpr Shape kShapes[] = {{1, 1}, {1, 8}, {4, 3}, {2, 5}};
 
-render::RenderResult run(const char* kernel, render::Engine engine, Shape shape) {
+render::RenderResult run(const char* kernel, render::Engine engine, Shape shape,
+                         bool profile = false) {
     render::RenderOptions o;
     o.scene = std::filesystem::path(TPSIM_SOURCE_DIR) / "scenes" / "cornell.toml";
     o.kernel = std::filesystem::path(TPSIM_KERNEL_DIR) / (std::string(kernel) + ".elf");
@@ -39,6 +42,7 @@ render::RenderResult run(const char* kernel, render::Engine engine, Shape shape)
     o.image_width = o.image_height = 16;
     o.chip.chip.num_tms = shape.tms;
     o.chip.chip.tps_per_tm = shape.tps;
+    o.profile = profile;
     return render::render(o);
 }
 
@@ -108,7 +112,8 @@ TEST_CASE("kernel api: the barrier orders every thread's writes before the reads
         };
         for (const render::Engine engine : kEngines) {
             INFO(name_of(engine) << " on " << shape.tms << " x " << shape.tps);
-            const render::RenderResult r = run("barrier_neighbour", engine, shape);
+            const bool timing = engine == render::Engine::timing;
+            const render::RenderResult r = run("barrier_neighbour", engine, shape, timing);
             for (int id = 0; id < n; ++id) {
                 const int rounds = id == n - 1 && n > 1 ? 1 : kRounds;
                 int sum = 0;
@@ -127,6 +132,16 @@ TEST_CASE("kernel api: the barrier orders every thread's writes before the reads
                 CHECK(r.instructions.per_fu[size_t(isa::FuClass::Sync)] ==
                       uint64_t(n > 1 ? 2 * kRounds * (n - 1) + 1 : 2 * kRounds));
                 if (n > 1) CHECK(s.value("chip/stalls/sync") > 0);
+                // Every TP-cycle is an issue or one stall, the waits included ...
+                double stalls = 0;
+                for (const std::string_view cause : render::kStallNames)
+                    stalls += s.value(fmt::format("chip/stalls/{}", cause));
+                CHECK(s.value("chip/active_tp_cycles") == s.value("chip/instructions") + stalls);
+                // ... and the profile charges each wait to its instruction.
+                uint64_t profiled = 0;
+                for (const timing::PcCounters& pc : r.timing->chip->profile().words)
+                    profiled += pc.stalls[size_t(timing::Stall::Sync)];
+                CHECK(double(profiled) == s.value("chip/stalls/sync"));
             }
         }
     }
