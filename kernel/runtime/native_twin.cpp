@@ -145,9 +145,8 @@ public:
             holder_[size_t(reg)] = running_;
             return;
         }
-        check_not_last_running(std::string("for semaphore ") + std::to_string(reg) +
-                               std::string(" (held by thread ") +
-                               std::to_string(holder_[size_t(reg)]) + ")");
+        check_not_last_running(std::string("for semaphore ") + std::to_string(reg) + " (" +
+                               holder_of(uint32_t(reg)) + ")");
         semaphore_waits_.push_back({uint32_t(reg), running_});
         wait();  // resumed holding it: the release handed it over
     }
@@ -278,13 +277,21 @@ private:
             std::vector<uint32_t> ids;
             for (const SemaphoreWait& w : semaphore_waits_)
                 if (w.reg == reg) ids.push_back(w.thread);
-            const uint32_t holder = holder_[reg];
-            const bool gone = holder != kNobody && threads_[holder].state == State::Done;
-            add(threads_named(ids) + std::string(" for semaphore ") + std::to_string(reg) +
-                std::string(" (held by thread ") + std::to_string(holder) +
-                (gone ? ", which exited)" : ")"));
+            add(threads_named(ids) + std::string(" for semaphore ") + std::to_string(reg) + " (" +
+                holder_of(reg) + ")");
         }
         return text;
+    }
+
+    /// "held by thread 2" and the like, as the simulator says it.
+    std::string holder_of(uint32_t reg) const {
+        const uint32_t holder = holder_[reg];
+        if (holder == kNobody)
+            return std::string("no thread acquired it, but global register ") +
+                   std::to_string(reg) + " is " + std::to_string(global_registers_[reg]) +
+                   ": is it used by atomicinc too?";
+        return std::string("held by thread ") + std::to_string(holder) +
+               (threads_[holder].state == State::Done ? ", which exited" : "");
     }
 
     char* take_stack() {

@@ -301,12 +301,20 @@ std::string Machine::describe_waiting() const {
         std::vector<uint32_t> ids;
         for (const SemaphoreWait& w : semaphore_waits_)
             if (w.reg == reg) ids.push_back(w.thread);
-        const uint32_t holder = semaphore_holder_[reg];
-        const bool gone = holder != kNoThread && threads_[holder].state == ThreadState::Exited;
-        parts.push_back(fmt::format("{} for semaphore {} (held by thread {}{})", threads_named(ids),
-                                    reg, holder, gone ? ", which exited" : ""));
+        parts.push_back(fmt::format("{} for semaphore {} ({})", threads_named(ids), reg,
+                                    semaphore_holder(reg)));
     }
     return fmt::format("{}", fmt::join(parts, "; "));
+}
+
+std::string Machine::semaphore_holder(uint32_t reg) const {
+    const uint32_t holder = semaphore_holder_[reg];
+    if (holder == kNoThread)
+        return fmt::format("no thread acquired it, but global register {} is {}: is it used by "
+                           "atomicinc too?",
+                           reg, global_registers_[reg]);
+    const bool gone = threads_[holder].state == ThreadState::Exited;
+    return fmt::format("held by thread {}{}", holder, gone ? ", which exited" : "");
 }
 
 void Machine::check_not_last_running(const std::string& waits) const {
@@ -367,8 +375,7 @@ uint32_t Machine::sem_acquire(uint32_t id, isa::Hart& h, uint32_t reg) {
         isa::complete(h);
         return 1;
     }
-    check_not_last_running(
-        fmt::format("for semaphore {} (held by thread {})", reg, semaphore_holder_[reg]));
+    check_not_last_running(fmt::format("for semaphore {} ({})", reg, semaphore_holder(reg)));
     semaphore_waits_.push_back({reg, id});
     suspend(id, h);
 }

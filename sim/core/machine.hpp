@@ -184,6 +184,8 @@ private:
     /// returns how many went.
     uint32_t release_barrier();
     void check_semaphore(uint32_t reg) const;
+    /// "held by thread 2" and the like, for deadlock messages.
+    std::string semaphore_holder(uint32_t reg) const;
     /// "threads 0-3 at the barrier, thread 5 for semaphore 2 (held by thread 1)".
     std::string describe_waiting() const;
     /// ThreadEnv's out-of-line paths (thread_env.hpp): the CSRs the machine answers (false for
