@@ -67,15 +67,15 @@ std::string disassemble(uint32_t word, uint32_t pc) {
     switch (insn.format) {
     case Format::R:
     case Format::R4:
-        operand(reg_name(d.rd));
+        if (d.rd != kNoReg) operand(reg_name(d.rd));  // tp.print has none
         operand(reg_name(d.rs1));
         if (d.rs2 != kNoReg) operand(reg_name(d.rs2));
         if (d.rs3 != kNoReg) operand(reg_name(d.rs3));
         if (insn.operands.rounding_mode) operand(kRoundingNames[d.rm]);
         break;
     case Format::I:
-        operand(reg_name(d.rd));
-        if (d.rs1 == kNoReg) {  // tp.atominc rd, imm
+        if (d.rd != kNoReg) operand(reg_name(d.rd));  // tp.semacq/semrel have none
+        if (d.rs1 == kNoReg) {                        // tp.atominc rd, imm; tp.semacq imm
             operand(std::to_string(d.imm));
         } else if (insn.fu == FuClass::Load || d.op == Op::jalr) {
             operand(offset_base(d.rs1));

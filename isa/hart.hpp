@@ -37,6 +37,13 @@ inline void trap(Hart& h, uint32_t cause, uint32_t tval) {
     h.pc = h.mtvec & ~3u;
 }
 
+/// What execute() does after an instruction that completes: the environment's synchronisation
+/// hooks (barrier, sem_acquire, sem_release) call it themselves, before the thread may wait.
+inline void complete(Hart& h) {
+    h.pc += 4;
+    ++h.instret;
+}
+
 // execute() lives in execute.hpp:
 //
 //   template <class Env> void execute(const Decoded& d, Hart& h, Env& env);
@@ -46,6 +53,10 @@ inline void trap(Hart& h, uint32_t cause, uint32_t tval) {
 //   template <class T> T    env.load(uint32_t addr);          // T: u8/i8/u16/i16/u32; may throw
 //   template <class T> void env.store(uint32_t addr, T value); // may throw
 //   uint32_t env.atomic_inc(uint32_t global_register);         // returns the old value
+//   void env.print(uint32_t address, uint32_t length);          // tp.print; may throw
+//   void env.barrier(Hart& h);                                  // pc still at the instruction;
+//   void env.sem_acquire(Hart& h, uint32_t global_register);    // the environment completes
+//   void env.sem_release(Hart& h, uint32_t global_register);    // them (complete()) or faults
 //   bool env.read_csr(uint32_t csr, uint32_t& value);          // machine CSRs (mhartid, cycle,
 //                                                              // custom); false = not mine
 //   void env.ecall(Hart& h);  void env.ebreak(Hart& h);        // pc still at the instruction

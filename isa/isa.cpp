@@ -48,6 +48,10 @@ std::string_view to_string(FuClass fu) {
         return "atomic";
     case FuClass::System:
         return "system";
+    case FuClass::Sync:
+        return "sync";
+    case FuClass::Print:
+        return "print";
     case FuClass::Count:
         break;
     }

@@ -35,6 +35,8 @@ enum class FuClass : uint8_t {
     Store,   ///< sw/sh/sb/fsw ...
     Atomic,  ///< global-register atomics (tpsim custom extension)
     System,  ///< csr*, fence*, ecall, ebreak, mret
+    Sync,    ///< barrier and semaphores (tpsim custom extension)
+    Print,   ///< kernel output (tpsim custom extension)
     Count
 };
 

@@ -2,6 +2,8 @@
 #include <memory>
 #include <string>
 
+#include <fmt/format.h>
+
 #include "sim/cli/commands.hpp"
 #include "sim/core/elf_loader.hpp"
 #include "sim/core/machine.hpp"
@@ -34,6 +36,7 @@ Command add_exec_command(CLI::App& app) {
                 tpsim::core::Machine machine(tpsim::core::load_elf(options->program),
                                              options->machine);
                 machine.run();
+                fmt::print("{}", machine.output().tagged());
                 return machine.thread(0).exit_code;
             }};
 }

@@ -28,6 +28,10 @@ std::string_view to_string(FaultKind kind) {
         return "bad global register";
     case FaultKind::InstructionLimit:
         return "instruction limit reached";
+    case FaultKind::Deadlock:
+        return "deadlock";
+    case FaultKind::SemaphoreNotHeld:
+        return "release of a free semaphore";
     }
     return "fault";
 }

@@ -22,6 +22,8 @@ enum class FaultKind : uint8_t {
     UnsupportedEcall,    ///< ecall other than exit, with no trap handler installed
     BadGlobalRegister,   ///< atomic on a global register that does not exist
     InstructionLimit,    ///< thread ran past --max-instructions
+    Deadlock,            ///< every thread still running waits (barrier, semaphore)
+    SemaphoreNotHeld,    ///< tp.semrel of a semaphore nobody holds
 };
 
 std::string_view to_string(FaultKind kind);

@@ -4,6 +4,7 @@
 #include <bit>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "isa/csr.hpp"
 #include "sim/core/error.hpp"
@@ -61,6 +62,9 @@ Machine::Machine(Program program, const MachineConfig& config)
     }
 
     threads_.resize(config_.threads);
+    running_threads_ = live_threads_ = config_.threads;
+    semaphore_holder_.fill(kNoThread);
+    output_ = trax::KernelOutput(config_.threads);
     for (Thread& t : threads_) {
         t.hart.pc = program_.entry;
         t.hart.reg[detail::kSp] =
@@ -158,6 +162,9 @@ void Machine::run_quantum(uint32_t id, uint64_t budget) {
                 ++per_op[size_t(d.op)];
                 isa::execute<ThreadEnv<false>, false>(d, h, env);
             }
+        } catch (const ThreadSuspended&) {
+            ++done;  // the instruction completed; the thread waits, so its quantum ends
+            break;
         } catch (const GuestFault& f) {
             if (!take_trap(h, f)) {
                 t.executed += done;
@@ -177,20 +184,16 @@ void Machine::run_quantum(uint32_t id, uint64_t budget) {
 }
 
 void Machine::run() {
-    std::vector<uint32_t> running;
-    for (uint32_t id = 0; id < thread_count(); ++id)
-        if (threads_[id].state == ThreadState::Running) running.push_back(id);
-    while (!running.empty()) {
-        size_t kept = 0;
-        for (uint32_t id : running) {
+    // Waiting threads are passed over; one that goes on runs again in its turn. The loop ends
+    // when no thread is left running: suspend() and exited() report a deadlock before then.
+    while (running_threads_ != 0)
+        for (uint32_t id = 0; id < thread_count(); ++id) {
             Thread& t = threads_[id];
+            if (t.state != ThreadState::Running) continue;
             const uint64_t left = instructions_left(t);
             if (left == 0) limit_fault(id);
             run_quantum(id, std::min<uint64_t>(left, config_.quantum));
-            if (t.state == ThreadState::Running) running[kept++] = id;
         }
-        running.resize(kept);
-    }
 }
 
 // Out of line: CSR reads are rare, and inlined into the flattened step they would only add
@@ -257,6 +260,173 @@ void Machine::illegal(uint32_t id, isa::Hart& h, const isa::Decoded& d) {
     throw GuestFault{FaultKind::IllegalInstruction,
                      fmt::format("has no valid rounding mode (frm = {})", h.frm),
                      "set frm to 0..4 (fsrm) or give the instruction a static rounding mode"};
+}
+
+namespace {
+
+/// "0-3, 5, 9-12": ascending ids with runs as ranges, at most a few dozen shown.
+std::string id_ranges(std::vector<uint32_t> ids) {
+    std::sort(ids.begin(), ids.end());
+    std::string text;
+    size_t shown = 0;
+    for (size_t i = 0; i < ids.size();) {
+        size_t j = i;
+        while (j + 1 < ids.size() && ids[j + 1] == ids[j] + 1)
+            ++j;
+        if (++shown > 24) {
+            text += ", ...";
+            break;
+        }
+        text += (text.empty() ? "" : ", ") +
+                (j == i ? std::to_string(ids[i]) : fmt::format("{}-{}", ids[i], ids[j]));
+        i = j + 1;
+    }
+    return text;
+}
+
+std::string threads_named(const std::vector<uint32_t>& ids) {
+    return (ids.size() == 1 ? "thread " : "threads ") + id_ranges(ids);
+}
+
+}  // namespace
+
+std::string Machine::describe_waiting() const {
+    std::vector<std::string> parts;
+    if (!at_barrier_.empty()) parts.push_back(threads_named(at_barrier_) + " at the barrier");
+    std::vector<uint32_t> regs;
+    for (const SemaphoreWait& w : semaphore_waits_)
+        if (std::find(regs.begin(), regs.end(), w.reg) == regs.end()) regs.push_back(w.reg);
+    std::sort(regs.begin(), regs.end());
+    for (uint32_t reg : regs) {
+        std::vector<uint32_t> ids;
+        for (const SemaphoreWait& w : semaphore_waits_)
+            if (w.reg == reg) ids.push_back(w.thread);
+        parts.push_back(fmt::format("{} for semaphore {} ({})", threads_named(ids), reg,
+                                    semaphore_holder(reg)));
+    }
+    return fmt::format("{}", fmt::join(parts, "; "));
+}
+
+std::string Machine::semaphore_holder(uint32_t reg) const {
+    const uint32_t holder = semaphore_holder_[reg];
+    if (holder == kNoThread)
+        return fmt::format("no thread acquired it, but global register {} is {}: is it used by "
+                           "atomicinc too?",
+                           reg, global_registers_[reg]);
+    const bool gone = threads_[holder].state == ThreadState::Exited;
+    return fmt::format("held by thread {}{}", holder, gone ? ", which exited" : "");
+}
+
+void Machine::check_not_last_running(const std::string& waits) const {
+    if (running_threads_ == 1)
+        throw GuestFault{FaultKind::Deadlock,
+                         fmt::format("waits {}, but every other thread that has not exited "
+                                     "waits too: {}",
+                                     waits, describe_waiting()),
+                         "release every semaphore a thread acquires before it waits at the "
+                         "barrier or exits, and acquire semaphores in the same order everywhere"};
+}
+
+void Machine::suspend(uint32_t id, isa::Hart& h) {
+    isa::complete(h);
+    threads_[id].state = ThreadState::Waiting;
+    --running_threads_;
+    throw ThreadSuspended{};
+}
+
+uint32_t Machine::release_barrier() {
+    if (at_barrier_.empty() || at_barrier_.size() != live_threads_) return 0;
+    for (uint32_t waiter : at_barrier_)
+        threads_[waiter].state = ThreadState::Running;
+    const auto released = uint32_t(at_barrier_.size());
+    running_threads_ += released;
+    at_barrier_.clear();
+    return released;
+}
+
+uint32_t Machine::barrier(uint32_t id, isa::Hart& h) {
+    // The last thread to arrive does not wait: it goes on with those that did.
+    if (at_barrier_.size() + 1 == live_threads_) {
+        isa::complete(h);
+        at_barrier_.push_back(id);
+        threads_[id].state = ThreadState::Waiting;  // as release_barrier() expects
+        --running_threads_;
+        return release_barrier();
+    }
+    check_not_last_running("at the barrier");
+    at_barrier_.push_back(id);
+    suspend(id, h);
+}
+
+void Machine::check_semaphore(uint32_t reg) const {
+    if (reg >= kGlobalRegisters)
+        throw GuestFault{FaultKind::BadGlobalRegister,
+                         fmt::format("uses global register {} as a semaphore, but there are only "
+                                     "{} (0..{})",
+                                     reg, kGlobalRegisters, kGlobalRegisters - 1),
+                         "use a register index below 256"};
+}
+
+uint32_t Machine::sem_acquire(uint32_t id, isa::Hart& h, uint32_t reg) {
+    check_semaphore(reg);
+    if (global_registers_[reg] == 0) {
+        global_registers_[reg] = 1;
+        semaphore_holder_[reg] = id;
+        isa::complete(h);
+        return 1;
+    }
+    check_not_last_running(fmt::format("for semaphore {} ({})", reg, semaphore_holder(reg)));
+    semaphore_waits_.push_back({reg, id});
+    suspend(id, h);
+}
+
+uint32_t Machine::sem_release(uint32_t, isa::Hart& h, uint32_t reg) {
+    check_semaphore(reg);
+    if (global_registers_[reg] != 1)
+        throw GuestFault{
+            FaultKind::SemaphoreNotHeld,
+            fmt::format("releases semaphore {}, which is not held (global register {} is {})", reg,
+                        reg, global_registers_[reg]),
+            "release only a semaphore the thread acquired, and use the register for nothing else"};
+    isa::complete(h);
+    // Handed over to the first waiter, which then holds it: the register stays 1.
+    const auto first = std::find_if(semaphore_waits_.begin(), semaphore_waits_.end(),
+                                    [reg](const SemaphoreWait& w) { return w.reg == reg; });
+    if (first == semaphore_waits_.end()) {
+        global_registers_[reg] = 0;
+        semaphore_holder_[reg] = kNoThread;
+        return 0;
+    }
+    const uint32_t next = first->thread;
+    semaphore_waits_.erase(first);
+    semaphore_holder_[reg] = next;
+    threads_[next].state = ThreadState::Running;
+    ++running_threads_;
+    return next + 1;
+}
+
+uint32_t Machine::exited(uint32_t) {
+    --live_threads_;
+    --running_threads_;
+    const uint32_t released = release_barrier();
+    if (running_threads_ == 0 && live_threads_ != 0)
+        throw GuestFault{FaultKind::Deadlock,
+                         fmt::format("exits while every other thread that has not exited waits: {}",
+                                     describe_waiting()),
+                         "release every semaphore a thread acquires before it exits"};
+    return released;
+}
+
+void Machine::print(uint32_t id, uint32_t address, uint32_t length, uint8_t* local) {
+    if (length > kMaxPrintBytes)
+        throw GuestFault{FaultKind::IllegalInstruction,
+                         fmt::format("prints {} bytes at once; tp.print takes at most {}", length,
+                                     kMaxPrintBytes),
+                         "print through trax_printf, which hands over its text in pieces"};
+    std::string bytes(length, '\0');
+    for (uint32_t i = 0; i < length; ++i)
+        bytes[i] = char(memory_.load<uint8_t>(address + i, local));
+    output_.append(id, bytes);
 }
 
 void Machine::refuse_step(uint32_t id) {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "isa/hart.hpp"
+#include "kernel/kernel_output.hpp"
 #include "sim/core/elf_loader.hpp"
 #include "sim/core/fault.hpp"
 #include "sim/core/memory.hpp"
@@ -37,7 +38,13 @@ struct MachineConfig {
     void validate() const;
 };
 
-enum class ThreadState : uint8_t { Running, Exited, Faulted };
+/// Waiting: at the barrier or for a semaphore (tp.barrier, tp.semacq), until another thread's
+/// instruction lets it go on.
+enum class ThreadState : uint8_t { Running, Waiting, Exited, Faulted };
+
+/// Thrown by a synchronisation instruction that completed and left its thread Waiting: the run
+/// loops stop running the thread there.
+struct ThreadSuspended {};
 
 /// Where an exited thread's pc is parked: below kCodeBase, so never fetchable.
 constexpr uint32_t kParkedPc = 0;
@@ -56,8 +63,10 @@ struct Thread {
 
 /// What one instruction did, for the timing model (step()).
 struct StepRecord {
-    uint32_t pc = 0;                     ///< address of the instruction
-    uint32_t atomic_result = 0;          ///< the value an atomic increment returned
+    uint32_t pc = 0;  ///< address of the instruction
+    /// The value an atomic increment returned; for the synchronisation instructions what the
+    /// chip needs to time them (see Machine::barrier and the semaphore functions).
+    uint32_t atomic_result = 0;
     const isa::Decoded* insn = nullptr;  ///< its pre-decoded form (registers, FU class)
     uint32_t mem_address = 0;            ///< effective address when mem_bytes != 0
     uint8_t mem_bytes = 0;               ///< access size; 0 = no memory access
@@ -74,13 +83,16 @@ struct Counters {
 
 /// Number of global registers for tp.atominc (all start at 0).
 constexpr uint32_t kGlobalRegisters = 256;
+/// The most bytes one tp.print hands over.
+constexpr uint32_t kMaxPrintBytes = 4096;
 
 class Machine {
 public:
     Machine(Program program, const MachineConfig& config);
 
-    /// Runs every thread to its exit, round-robin by thread id in fixed quanta, so results never
-    /// depend on anything but the program and the config. Throws Fault on the first guest fault.
+    /// Runs every thread to its exit, round-robin by thread id in fixed quanta (a waiting thread
+    /// is passed over until it may go on), so results never depend on anything but the program
+    /// and the config. Throws Fault on the first guest fault, a deadlock included.
     void run();
 
     /// Executes one instruction of a running thread and reports what it did. Throws Fault.
@@ -116,6 +128,8 @@ public:
     const std::vector<CodeRange>& code() const { return code_; }
     const Counters& counters() const { return counters_; }
     uint32_t global_register(uint32_t index) const { return global_registers_.at(index); }
+    /// What the threads printed (tp.print).
+    const trax::KernelOutput& output() const { return output_; }
 
 private:
     template <bool kRecord> friend class ThreadEnv;
@@ -148,6 +162,32 @@ private:
         return left;
     }
     [[noreturn]] void refuse_step(uint32_t id);
+
+    // The synchronisation instructions and exit (ThreadEnv's hooks). Each returns what the
+    // chip needs to time it (StepRecord::atomic_result): barrier() the number of threads the
+    // arrival lets go on (itself included; 0 if it waits), sem_acquire() 1 if it got the
+    // semaphore at once (0: it waits until a release hands it over), sem_release() 1 + the
+    // thread it hands the semaphore to (0: none waited), exited() the number of threads
+    // waiting at the barrier the exit lets go on. A thread that must wait is completed, set
+    // Waiting and ThreadSuspended is thrown; a deadlock throws GuestFault.
+    [[gnu::cold]] uint32_t barrier(uint32_t id, isa::Hart& h);
+    [[gnu::cold]] uint32_t sem_acquire(uint32_t id, isa::Hart& h, uint32_t reg);
+    [[gnu::cold]] uint32_t sem_release(uint32_t id, isa::Hart& h, uint32_t reg);
+    [[gnu::cold]] uint32_t exited(uint32_t id);
+    [[gnu::cold]] void print(uint32_t id, uint32_t address, uint32_t length, uint8_t* local);
+    /// Throws the deadlock GuestFault if the calling thread is the last one running, so
+    /// that nothing could end the wait it is about to begin (`waits`: "at the barrier" ...).
+    void check_not_last_running(const std::string& waits) const;
+    /// Completes the instruction and sets thread `id` Waiting; throws ThreadSuspended.
+    [[noreturn]] void suspend(uint32_t id, isa::Hart& h);
+    /// Lets the barrier's waiters go on if every thread that has not exited is one of them;
+    /// returns how many went.
+    uint32_t release_barrier();
+    void check_semaphore(uint32_t reg) const;
+    /// "held by thread 2" and the like, for deadlock messages.
+    std::string semaphore_holder(uint32_t reg) const;
+    /// "threads 0-3 at the barrier, thread 5 for semaphore 2 (held by thread 1)".
+    std::string describe_waiting() const;
     /// ThreadEnv's out-of-line paths (thread_env.hpp): the CSRs the machine answers (false for
     /// others), and an illegal or unimplemented instruction (traps to mtvec or throws), or a
     /// pc-relative jump with a misaligned offset (pre-decoded as illegal; run here).
@@ -175,6 +215,17 @@ private:
     std::vector<Privacy> privacy_;
     std::vector<Thread> threads_;
     std::array<uint32_t, kGlobalRegisters> global_registers_{};
+    uint32_t running_threads_ = 0;      ///< threads Running
+    uint32_t live_threads_ = 0;         ///< threads Running or Waiting
+    std::vector<uint32_t> at_barrier_;  ///< waiting at the barrier, in arrival order
+    struct SemaphoreWait {
+        uint32_t reg, thread;
+    };
+    std::vector<SemaphoreWait> semaphore_waits_;  ///< in arrival order (FIFO hand-over)
+    /// The thread that acquired each semaphore last (for messages); kNoThread: never.
+    static constexpr uint32_t kNoThread = UINT32_MAX;
+    std::array<uint32_t, kGlobalRegisters> semaphore_holder_;
+    trax::KernelOutput output_;
     Counters counters_;
     const uint64_t* cycle_counter_ = nullptr;
 };

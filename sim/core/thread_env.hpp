@@ -54,6 +54,11 @@ public:
 
     bool read_csr(uint32_t csr, uint32_t& value) { return machine_.read_csr(id_, csr, value); }
 
+    void print(uint32_t address, uint32_t length) { machine_.print(id_, address, length, local_); }
+    void barrier(isa::Hart& h) { report(machine_.barrier(id_, h)); }
+    void sem_acquire(isa::Hart& h, uint32_t reg) { report(machine_.sem_acquire(id_, h, reg)); }
+    void sem_release(isa::Hart& h, uint32_t reg) { report(machine_.sem_release(id_, h, reg)); }
+
     void ecall(isa::Hart& h) {
         const uint32_t number = h.reg[detail::kA7];
         if (number == detail::kExitSyscall) {
@@ -62,6 +67,7 @@ public:
             thread_.exit_pc = h.pc;
             h.pc = kParkedPc;
             if constexpr (kRecord) record_->exited = true;
+            report(machine_.exited(id_));
             return;
         }
         if (h.mtvec != 0) return isa::trap(h, isa::cause::kEcallM, 0);
@@ -104,6 +110,11 @@ private:
                                      detail::kExitSyscall),
                          "call exit through the kernel runtime, or install a trap handler in "
                          "mtvec"};
+    }
+
+    /// What a synchronisation instruction or exit tells the chip (StepRecord::atomic_result).
+    void report(uint32_t value) {
+        if constexpr (kRecord) record_->atomic_result = value;
     }
 
     void record_access(uint32_t addr, uint8_t bytes, bool store) {
@@ -177,6 +188,8 @@ private:
                 !is_private(h, std::rotr(h.pc - text_base, 2), text_words, first))
                 break;
         }
+    } catch (const ThreadSuspended&) {
+        ++n;  // the instruction completed; the thread waits, so the batch ends with it
     } catch (const GuestFault& f) {
         if (!take_trap(h, f)) {
             count();

@@ -13,6 +13,7 @@
 
 #include <fmt/format.h>
 
+#include "kernel/kernel_output.hpp"
 #include "kernel/native_twin.h"
 #include "sim/core/error.hpp"
 
@@ -72,8 +73,9 @@ std::filesystem::path native_twin_of(const std::filesystem::path& kernel_elf) {
     return kernel_elf.parent_path() / ("lib" + kernel_elf.stem().string() + "_native.so");
 }
 
-void run_native_twin(const std::filesystem::path& library, std::vector<uint32_t>& global_words,
-                     uint32_t num_threads, uint32_t num_tms, uint32_t tm_size) {
+trax::KernelOutput run_native_twin(const std::filesystem::path& library,
+                                   std::vector<uint32_t>& global_words, uint32_t num_threads,
+                                   uint32_t num_tms, uint32_t tm_size) {
     // RTLD_LOCAL keeps each twin's copy of the trax runtime to itself.
     const std::unique_ptr<void, int (*)(void*)> handle(
         dlopen(std::filesystem::absolute(library).c_str(), RTLD_NOW | RTLD_LOCAL), dlclose);
@@ -90,13 +92,22 @@ void run_native_twin(const std::filesystem::path& library, std::vector<uint32_t>
     // The twin is the student's code running on the host: a wild pointer or runaway recursion
     // there is a real SIGSEGV. It runs in a child process over shared memory so that such a
     // crash becomes an error message here instead of killing tpsim.
+    // Shared: the error message, the kernel's output (dropped count, lengths, bytes) and the
+    // memory image, each aligned for its type.
     const size_t image_bytes = global_words.size() * sizeof(uint32_t);
-    SharedMapping shared(kErrorBytes + image_bytes);
+    constexpr uint64_t kOutputLimit = trax::KernelOutput::kDefaultLimitBytes;
+    const size_t lengths_bytes = size_t(num_threads) * sizeof(uint32_t);
+    SharedMapping shared(kErrorBytes + sizeof(uint64_t) + lengths_bytes + image_bytes +
+                         kOutputLimit);
     char* const error = static_cast<char*>(shared.data());
-    uint32_t* const words = reinterpret_cast<uint32_t*>(error + kErrorBytes);
+    auto* const dropped = reinterpret_cast<uint64_t*>(error + kErrorBytes);
+    auto* const lengths = reinterpret_cast<uint32_t*>(dropped + 1);
+    uint32_t* const words = lengths + num_threads;
+    char* const output = reinterpret_cast<char*>(words + global_words.size());
     std::memcpy(words, global_words.data(), image_bytes);
     const TraxNativeContext context{
-        words, uint32_t(global_words.size()), num_threads, num_tms, tm_size, error, kErrorBytes};
+        words,  uint32_t(global_words.size()), num_threads, num_tms, tm_size, error, kErrorBytes,
+        output, uint32_t(kOutputLimit),        lengths,     dropped};
     const pid_t child = fork();
     if (child < 0)
         throw Error(
@@ -119,6 +130,14 @@ void run_native_twin(const std::filesystem::path& library, std::vector<uint32_t>
         throw Error(error[0] != '\0' ? std::string(error, strnlen(error, kErrorBytes))
                                      : "the native twin failed without saying why");
     std::memcpy(global_words.data(), words, image_bytes);
+    // The twin wrote at most kOutputLimit bytes; a corrupt length cannot read past them.
+    std::vector<std::string> threads(num_threads);
+    for (size_t id = 0, at = 0; id < num_threads; ++id) {
+        const size_t length = std::min<size_t>(lengths[id], kOutputLimit - at);
+        threads[id].assign(output + at, length);
+        at += length;
+    }
+    return trax::KernelOutput::from_parts(std::move(threads), kOutputLimit, *dropped);
 }
 
 }  // namespace tpsim::render

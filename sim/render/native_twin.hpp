@@ -4,14 +4,18 @@
 #include <filesystem>
 #include <vector>
 
+#include "kernel/kernel_output.hpp"
+
 namespace tpsim::render {
 
 /// The twin library that belongs to a kernel ELF: dir/NAME.elf -> dir/libNAME_native.so.
 std::filesystem::path native_twin_of(const std::filesystem::path& kernel_elf);
 
 /// Loads the twin and runs it over `global_words` (modified in place) with the given thread
-/// shape. Throws tpsim::Error if the library cannot be loaded or the kernel reports an error.
-void run_native_twin(const std::filesystem::path& library, std::vector<uint32_t>& global_words,
-                     uint32_t num_threads, uint32_t num_tms, uint32_t tm_size);
+/// shape; returns what the kernel printed. Throws tpsim::Error if the library cannot be loaded
+/// or the kernel reports an error.
+trax::KernelOutput run_native_twin(const std::filesystem::path& library,
+                                   std::vector<uint32_t>& global_words, uint32_t num_threads,
+                                   uint32_t num_tms, uint32_t tm_size);
 
 }  // namespace tpsim::render

@@ -21,14 +21,14 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 }
 
 /// Runs the kernel on the functional machine over the image, in place.
-InstructionCounts run_functional(const core::Program& program, image::MemoryImage& image,
-                                 const timing::ChipConfig& chip, uint64_t max_instructions,
-                                 uint64_t max_item_instructions) {
+KernelRun run_functional(const core::Program& program, image::MemoryImage& image,
+                         const timing::ChipConfig& chip, uint64_t max_instructions,
+                         uint64_t max_item_instructions) {
     const auto machine = timing::make_machine(program, image.words, image.read_only_bytes(), chip,
                                               max_instructions, max_item_instructions);
     machine->run();
     std::memcpy(image.words.data(), machine->memory().global().data(), image.bytes());
-    return InstructionCounts::of(machine->counters());
+    return {InstructionCounts::of(machine->counters()), machine->output()};
 }
 
 }  // namespace
@@ -59,22 +59,23 @@ uint64_t default_item_instructions(const scene::Scene& scene) {
     return per_ray * rays;
 }
 
-InstructionCounts run_kernel(const Kernel& kernel, Engine engine, image::MemoryImage& image,
-                             const timing::ChipConfig& chip, uint64_t max_instructions,
-                             uint64_t max_item_instructions) {
+KernelRun run_kernel(const Kernel& kernel, Engine engine, image::MemoryImage& image,
+                     const timing::ChipConfig& chip, uint64_t max_instructions,
+                     uint64_t max_item_instructions) {
     switch (engine) {
     case Engine::functional:
         return run_functional(kernel.program, image, chip, max_instructions, max_item_instructions);
     case Engine::native:
-        run_native_twin(native_twin_of(kernel.elf), image.words,
-                        chip.chip.num_tms * chip.chip.tps_per_tm, chip.chip.num_tms,
-                        chip.chip.tps_per_tm);
-        break;
+        return {{},
+                run_native_twin(native_twin_of(kernel.elf), image.words,
+                                chip.chip.num_tms * chip.chip.tps_per_tm, chip.chip.num_tms,
+                                chip.chip.tps_per_tm)};
     case Engine::timing: {
         TimingRunOptions watch;
         watch.max_instructions = max_instructions;
         watch.max_item_instructions = max_item_instructions;
-        return run_timing(kernel.program, image, chip, watch)->instructions;
+        const auto run = run_timing(kernel.program, image, chip, watch);
+        return {run->instructions, run->machine->output()};
     }
     }
     return {};
@@ -119,9 +120,12 @@ RenderResult render(const RenderOptions& options) {
             result.profile = std::make_shared<const Profile>(
                 profile_of(result.timing->chip->profile(), kernel.program));
         result.instructions = result.timing->instructions;
+        result.output = result.timing->machine->output();
     } else {
-        result.instructions = run_kernel(kernel, options.engine, result.image, options.chip,
-                                         options.max_instructions, item_limit);
+        KernelRun run = run_kernel(kernel, options.engine, result.image, options.chip,
+                                   options.max_instructions, item_limit);
+        result.instructions = run.instructions;
+        result.output = std::move(run.output);
     }
     result.run_seconds = seconds_since(start);
     result.traversal = image::read_thread_stats(result.image.header, result.image.words.data());

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "isa/isa.hpp"
+#include "kernel/kernel_output.hpp"
 #include "sim/core/elf_loader.hpp"
 #include "sim/image/memory_image.hpp"
 #include "sim/scene/bvh.hpp"
@@ -86,6 +87,12 @@ struct InstructionCounts {
     static InstructionCounts of(const core::Counters& counters);
 };
 
+/// What run_kernel() reports of a run.
+struct KernelRun {
+    InstructionCounts instructions;  ///< zero for the native twin
+    trax::KernelOutput output;       ///< what the kernel printed
+};
+
 struct RenderResult {
     scene::Scene scene;                  ///< as loaded (triangles included)
     std::optional<scene::BvhStats> bvh;  ///< when a BVH was built
@@ -93,6 +100,7 @@ struct RenderResult {
     image::TraversalTotals traversal;    ///< the kernel's per-thread statistics, summed
     std::vector<float> rgb;              ///< framebuffer, linear RGB, row 0 at the top
     InstructionCounts instructions;      ///< zero for the native engine
+    trax::KernelOutput output;           ///< what the kernel printed (trax_printf)
     uint32_t threads = 0;
     std::shared_ptr<const TimingRun> timing;  ///< Engine::timing: the chip and its counters
     std::shared_ptr<const Profile> profile;   ///< RenderOptions::profile: by function and line
@@ -114,10 +122,8 @@ uint64_t default_item_instructions(const scene::Scene& scene);
 
 /// Runs a kernel over a memory image, in place, on the chosen engine with the chip's thread
 /// shape: the building block of render() and of tests that bring their own image (ray_query).
-/// Returns the instruction counts (zero for the native twin).
-InstructionCounts run_kernel(const Kernel& kernel, Engine engine, image::MemoryImage& image,
-                             const timing::ChipConfig& chip,
-                             uint64_t max_instructions = uint64_t(1) << 32,
-                             uint64_t max_item_instructions = 0);
+KernelRun run_kernel(const Kernel& kernel, Engine engine, image::MemoryImage& image,
+                     const timing::ChipConfig& chip, uint64_t max_instructions = uint64_t(1) << 32,
+                     uint64_t max_item_instructions = 0);
 
 }  // namespace tpsim::render

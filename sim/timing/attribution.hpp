@@ -16,6 +16,7 @@ enum class Stall : uint8_t {
     FuBusy,         ///< operands ready but every unit of the pool was taken
     MemoryPort,     ///< a previous load/store still waits for an L1 bank or MSHR
     Operand,        ///< an operand is not ready; attributed to its producing pool
+    Sync,           ///< waiting at the barrier or for a semaphore (tp.barrier, tp.semacq ...)
     Count
 };
 constexpr size_t kStallCauses = static_cast<size_t>(Stall::Count);

@@ -18,6 +18,9 @@ namespace tpsim::timing {
 namespace {
 
 constexpr uint64_t kNever = UINT64_MAX;
+/// wake_at of a TP waiting at the barrier or for a semaphore: only the global-register unit's
+/// reply wakes it (Tm::wake_from_sync), not the replies wake() serves.
+constexpr uint64_t kSyncWait = kNever - 1;
 constexpr uint64_t kDeadlockCycles = 1'000'000;
 constexpr size_t kPools = static_cast<size_t>(Pool::Count);
 constexpr size_t kStalls = static_cast<size_t>(Stall::Count);
@@ -123,6 +126,19 @@ struct Chip::Tm {
         if (profile)
             if (PcCounters* pc = profile->at(tp.pending.pc))
                 pc->stalls[size_t(Stall::Operand)] += now - tp.asleep_from;
+        tp.wake_at = now;
+    }
+    /// The global-register unit's reply to a synchronisation instruction: the TP, asleep since
+    /// it issued the instruction, gets its sync stall cycles and runs again.
+    void wake_from_sync(uint32_t i, uint64_t now) {
+        Tp& tp = tps[i];
+        set_bit(awake_tps, i);
+        const uint64_t waited = now - tp.asleep_from;
+        counters.active_tp_cycles += waited;
+        counters.stalls[size_t(Stall::Sync)] += waited;
+        if (profile)
+            if (PcCounters* pc = profile->at(tp.pending.pc))
+                pc->stalls[size_t(Stall::Sync)] += waited;
         tp.wake_at = now;
     }
     /// TP i leaves the awake set until cycle `at` (> now), when the wheel puts it back. A
@@ -404,10 +420,28 @@ void Chip::tick_shared(uint64_t now) {
     AtomicReply atomic;
     while (global_registers_.pop_reply(now, atomic)) {
         Tm& tm = *tms_[atomic.request.tm];
-        tm.tps[atomic.request.tp].reg_ready[atomic.request.tag] = now;
-        tm.wake(atomic.request.tp, now);
+        if (atomic.request.kind == GlobalRequest::Increment) [[likely]] {
+            tm.tps[atomic.request.tp].reg_ready[atomic.request.tag] = now;
+            tm.wake(atomic.request.tp, now);
+        } else {
+            tm.wake_from_sync(atomic.request.tp, now);
+        }
         ++progress_;
     }
+}
+
+void Chip::send_sync(Tm& tm, uint32_t i, const StepInfo& s, uint64_t now) {
+    const isa::Op op = s.insn->op;
+    const GlobalRequest kind = op == isa::Op::tp_barrier  ? GlobalRequest::Barrier
+                               : op == isa::Op::tp_semacq ? GlobalRequest::SemAcquire
+                                                          : GlobalRequest::SemRelease;
+    tm.atomics_out.push_back({now, tm.id, tm.atomic_sequence++, i, 0, kind, s.atomic_result,
+                              tm.id * config_.chip.tps_per_tm + i});
+    // Asleep until the unit's reply (wake_from_sync): the TP fetches nothing meanwhile.
+    Tm::Tp& tp = tm.tps[i];
+    clear_bit(tm.awake_tps, i);
+    tp.wake_at = kSyncWait;
+    tp.asleep_from = now + 1;
 }
 
 template <class Source, uint32_t kWords, bool kProfile>
@@ -587,9 +621,13 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             ++tp.item_instructions;
             if constexpr (kProfile) ++profile_at(s.pc).executions;
             uint64_t result_at = ready;
-            if (fu == isa::FuClass::Atomic) {
-                result_at = kNever;  // set by the global-register reply
-                tm.atomics_out.push_back({now, tm.id, tm.atomic_sequence++, i, d.rd});
+            if (pool == Pool::Atomic) [[unlikely]] {
+                if (fu == isa::FuClass::Atomic) {
+                    result_at = kNever;  // set by the global-register reply
+                    tm.atomics_out.push_back({now, tm.id, tm.atomic_sequence++, i, d.rd});
+                } else {
+                    send_sync(tm, i, s, now);
+                }
             } else if (s.mem_bytes != 0 && is_local(s.mem_address)) {
                 tp.lowest_local = std::min(tp.lowest_local, s.mem_address);
                 ++(s.mem_store ? counters.local_stores : counters.local_loads);
@@ -611,6 +649,10 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
                 clear_bit(tm.awake_tps, i);
                 --tm.running;
                 charge_item(tp.item, now + 1 - tp.item_since, tp.item_instructions);
+                if (s.atomic_result != 0)  // the exit lets threads at the barrier go on
+                    tm.atomics_out.push_back({now, tm.id, tm.atomic_sequence++, i, 0,
+                                              GlobalRequest::Exit, s.atomic_result,
+                                              first_thread + i});
             } else if (fu == isa::FuClass::Branch) {
                 // The bubble after a branch: no fetch before now + 1 + bubble.
                 const uint32_t bubble =
@@ -630,8 +672,8 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
 
 namespace {
 
-constexpr std::string_view kStallNames[] = {"fetch_conflict", "branch", "fu_busy", "memory_port",
-                                            "operand"};
+constexpr std::string_view kStallNames[] = {"fetch_conflict", "branch",  "fu_busy",
+                                            "memory_port",    "operand", "sync"};
 static_assert(std::size(kStallNames) == kStalls);
 
 }  // namespace

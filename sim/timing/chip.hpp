@@ -104,6 +104,10 @@ private:
         costs.instructions += instructions;
     }
     void tick_shared(uint64_t now);
+    /// A synchronisation instruction of TP i issues: its request goes to the global-register
+    /// unit, and the TP sleeps until the reply. Cold: out of the issue loop.
+    [[gnu::cold, gnu::noinline]] void send_sync(Tm& tm, uint32_t i, const StepInfo& s,
+                                                uint64_t now);
     // kWords: words per TP bit set, 0 = any; kProfile: collect the PcProfile.
     template <class Source, uint32_t kWords, bool kProfile>
     void tick_tm(Tm& tm, uint64_t now, Source& source);

@@ -12,6 +12,7 @@ Pool pool_of(isa::FuClass fu) {
     switch (fu) {
     case FuClass::IntAlu:
     case FuClass::System:
+    case FuClass::Print:
         return Pool::IntAlu;
     case FuClass::IntMul:
     case FuClass::IntDiv:
@@ -31,6 +32,7 @@ Pool pool_of(isa::FuClass fu) {
     case FuClass::Store:
         return Pool::LoadStore;
     case FuClass::Atomic:
+    case FuClass::Sync:  // served by the global-register unit, as atomics are
         return Pool::Atomic;
     case FuClass::Count:
         break;

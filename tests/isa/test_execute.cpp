@@ -217,6 +217,28 @@ TEST_CASE("system instructions", "[isa][execute]") {
     CHECK((h.mstatus & (1u << 3)) != 0);
 }
 
+TEST_CASE("tp.print and the synchronisation instructions reach the environment",
+          "[isa][execute][custom]") {
+    Hart h;
+    FakeEnv env;
+    std::memcpy(&env.memory[100], "hello", 5);
+    h.reg[10] = 100;
+    h.reg[11] = 5;
+    run(h, env, 11u << 20 | 10u << 15 | 1u << 12 | 0x0b);  // tp.print a0, a1
+    CHECK(env.printed == "hello");
+    CHECK(h.pc == 4);
+    CHECK(h.instret == 1);
+    run(h, env, 0x0000200b);                  // tp.barrier
+    run(h, env, 9u << 20 | 3u << 12 | 0x0b);  // tp.semacq 9
+    run(h, env, 9u << 20 | 4u << 12 | 0x0b);  // tp.semrel 9
+    CHECK(env.barriers == 1);
+    CHECK(env.acquired == std::vector<uint32_t>{9});
+    CHECK(env.released == std::vector<uint32_t>{9});
+    // The environment completed each once: not twice.
+    CHECK(h.pc == 16);
+    CHECK(h.instret == 4);
+}
+
 TEST_CASE("tp.atominc returns the old value and increments", "[isa][execute][custom]") {
     Hart h;
     FakeEnv env;

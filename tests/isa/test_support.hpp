@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <cstring>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "isa/csr.hpp"
@@ -76,6 +77,27 @@ struct FakeEnv {
         std::memcpy(&memory[addr], &value, sizeof value);
     }
     uint32_t atomic_inc(uint32_t reg) { return globals[reg]++; }
+    // The synchronisation hooks record their calls and complete the instruction, as the
+    // machine does when the thread need not wait.
+    std::string printed;
+    int barriers = 0;
+    std::vector<uint32_t> acquired, released;
+    void print(uint32_t address, uint32_t length) {
+        check(address, length);
+        printed.append(reinterpret_cast<const char*>(&memory[address]), length);
+    }
+    void barrier(Hart& h) {
+        ++barriers;
+        complete(h);
+    }
+    void sem_acquire(Hart& h, uint32_t reg) {
+        acquired.push_back(reg);
+        complete(h);
+    }
+    void sem_release(Hart& h, uint32_t reg) {
+        released.push_back(reg);
+        complete(h);
+    }
     bool read_csr(uint32_t csr, uint32_t& value) {
         switch (csr) {
         case csr::kMhartid:

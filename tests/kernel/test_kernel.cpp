@@ -88,7 +88,11 @@ struct Twin {
                                     tms,
                                     tm_size,
                                     error,
-                                    sizeof error};
+                                    sizeof error,
+                                    nullptr,
+                                    0,
+                                    nullptr,
+                                    nullptr};
         const int status = run(&ctx);
         CHECK((status == 0) == (error[0] == '\0'));
         return error;
@@ -225,7 +229,8 @@ TEST_CASE("kernel: the native twin reports bad accesses and bad contexts instead
     CHECK_THAT(hello(image, 0, 1, 1), Catch::Contains("at least 1"));
     CHECK_THAT(hello(image, 9, 2, 4), Catch::Contains("do not fit"));
     char message[64] = "";
-    const TraxNativeContext no_memory{nullptr, 0, 1, 1, 1, message, sizeof message};
+    const TraxNativeContext no_memory{nullptr,        0,       1, 1,       1,      message,
+                                      sizeof message, nullptr, 0, nullptr, nullptr};
     CHECK(hello.run(&no_memory) != 0);
     CHECK_THAT(std::string(message), Catch::Contains("no global memory"));
 }
