@@ -64,6 +64,7 @@ tpsim_native_run(const TraxNativeContext* ctx) {
             thread.thread_id = static_cast<int>(id);
             thread.tm_id = static_cast<int>(id / ctx->tm_size);
             thread.tp_id = static_cast<int>(id % ctx->tm_size);
+            thread.rand_state = 0;  // a new thread: trax_rand() seeds itself on its first draw
             trax_main();
         }
     } catch (const std::exception& e) {
