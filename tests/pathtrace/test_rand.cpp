@@ -38,7 +38,7 @@ TEST_CASE("rand: the simulator and the native twin draw the same numbers", "[ran
     }
 }
 
-TEST_CASE("rand: numbers lie in [0, 1), 24-bit steps, uniformly spread", "[rand]") {
+TEST_CASE("rand: numbers lie in 0 <= x < 1, in 24-bit steps, uniformly spread", "[rand]") {
     const std::vector<float> values = probe(render::Engine::native, 1);
     double sum = 0, sum2 = 0;
     std::vector<int> buckets(16);
