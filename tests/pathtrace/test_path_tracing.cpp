@@ -64,6 +64,19 @@ TEST_CASE("path tracing: the starter shows only the emitters the camera sees", "
     CHECK(black > r.rgb.size() / 3 * 9 / 10);
 }
 
+TEST_CASE("path tracing: a generated sphere emits from its outside", "[pathtrace]") {
+    const render::RenderResult r =
+        render_with("path_tracing_starter.elf", render::Engine::native, 16, 1, 0,
+                    write_scene("lamp.toml", "[materials]\nlamp = { emission = [4, 3, 2] }\n"
+                                             "[[generators]]\ntype = \"sphere\"\n"
+                                             "center = [0, 0, 0]\nradius = 1\n"
+                                             "material = \"lamp\"\n"));
+    size_t lit = 0;
+    for (size_t p = 0; p < r.rgb.size() / 3; ++p)
+        lit += glm::vec3(r.rgb[3 * p], r.rgb[3 * p + 1], r.rgb[3 * p + 2]) == glm::vec3(4, 3, 2);
+    CHECK(lit > r.rgb.size() / 3 / 8);  // the default camera frames the sphere: ~20 %
+}
+
 #ifdef TPSIM_HAVE_SOLUTIONS
 
 TEST_CASE("path tracing: the solution is bit-identical on the simulator and the twin",
