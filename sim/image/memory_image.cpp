@@ -145,7 +145,11 @@ MemoryImage build_memory_image(const scene::Scene& scene, const scene::Bvh* bvh,
         uint64_t(h.triangles.count) * layout::kTriangleWords +
         uint64_t(h.bvh_nodes.count) * layout::kBvhNodeWords + pixels * layout::kPixelWords +
         uint64_t(threads) * layout::kThreadStatsWords +
-        uint64_t(rays.size()) * (layout::kRayWords + layout::kRayResultWords) + 4096;
+        uint64_t(rays.size()) * (layout::kRayWords + layout::kRayResultWords) +
+        (extras_seed ? uint64_t(h.triangles.count) * layout::kEmitterWords +
+                           uint64_t(h.materials.count) * layout::kEmissionWords
+                     : 0) +
+        4096;
     // Global memory spans kGlobalBase..kLocalTop - kStackGuard in the guest address space.
     constexpr uint64_t kMaxWords =
         (trax::map::kLocalTop - trax::map::kStackGuard - trax::map::kGlobalBase) / 4;
