@@ -14,7 +14,7 @@ namespace trax::layout {
 /// "TPSC" little-endian: lets the loader and the twin reject a memory image that is not a scene.
 constexpr uint32_t kMagic = 0x4353'5054u;
 /// Bumped whenever a struct below changes shape.
-constexpr uint32_t kVersion = 3;
+constexpr uint32_t kVersion = 4;
 
 /// Sections start on 16-word (64-byte, one cache line) boundaries so no record of one section
 /// shares a line with another section.
@@ -23,6 +23,10 @@ constexpr int32_t kSectionAlignWords = 16;
 /// Name of the marker symbol a kernel's ELF defines (TRAX_USES_BVH in trax.hpp) when it
 /// traverses the BVH: the host builds a BVH and lays it out only for such kernels.
 constexpr const char* kUsesBvhSymbol = "trax_uses_bvh";
+/// Name of the marker symbol trax.hpp's emitter and random-number functions leave in a kernel's
+/// ELF: the host adds the SceneExtras sections only for such kernels, so the memory image (and
+/// every statistic) of a kernel that reads neither stays as it was before they existed.
+constexpr const char* kUsesExtrasSymbol = "trax_uses_extras";
 
 /// Feature flags in SceneHeader::flags: rendering choices the scene file makes.
 enum Feature : uint32_t {
@@ -56,6 +60,32 @@ struct PointLight {
 /// Lambertian material.
 struct Material {
     float diffuse[3];  ///< albedo, linear RGB
+};
+
+/// What a material emits: radiance per channel (linear RGB), the same from every point of the
+/// surface and in every direction of its front side, the side the triangle's normal
+/// (v1 - v0) x (v2 - v0) points to (an OBJ's counter-clockwise face). Independent of the scene's
+/// scale.
+struct Emission {
+    float radiance[3];
+};
+
+/// One emissive triangle, for light sampling (next-event estimation): pick emitter i with
+/// probability `probability` (proportional to area times mean radiance; draw u in [0,1) and
+/// take the first i with u < cdf), then a uniform point on it (density 1 / area).
+struct Emitter {
+    int32_t triangle;   ///< index into the triangles section (image order)
+    float area;         ///< in the image's units
+    float probability;  ///< of picking this emitter; they sum to 1
+    float cdf;          ///< sum of the probabilities up to and including this one; last = 1
+};
+
+/// The optional part of the image: present only for kernels that read it (kUsesExtrasSymbol),
+/// always at word kExtrasAddr, the first section after the header.
+struct SceneExtras {
+    uint32_t seed;        ///< the run's seed (tpsim render --seed), for trax_rand()'s seeding
+    SectionRef emission;  ///< one Emission per material (count = materials count)
+    SectionRef emitters;  ///< one Emitter per emissive triangle (count 0: nothing emits)
 };
 
 /// Triangle as the Woop et al. 2013 watertight test wants it: the three vertices.
@@ -156,6 +186,9 @@ struct RayResult {
 constexpr int32_t kCameraWords = sizeof(Camera) / 4;
 constexpr int32_t kPointLightWords = sizeof(PointLight) / 4;
 constexpr int32_t kMaterialWords = sizeof(Material) / 4;
+constexpr int32_t kEmissionWords = sizeof(Emission) / 4;
+constexpr int32_t kEmitterWords = sizeof(Emitter) / 4;
+constexpr int32_t kExtrasWords = sizeof(SceneExtras) / 4;
 constexpr int32_t kTriangleWords = sizeof(Triangle) / 4;
 constexpr int32_t kBvhNodeWords = sizeof(BvhNode) / 4;
 constexpr int32_t kPixelWords = 3;
@@ -195,6 +228,14 @@ enum RecordWord : int32_t {
     kLightPosition = 0,
     kLightColor = 3,
     kMaterialDiffuse = 0,
+    kEmissionRadiance = 0,
+    kEmitterTriangle = 0,
+    kEmitterArea = 1,
+    kEmitterProbability = 2,
+    kEmitterCdf = 3,
+    kExtrasSeed = 0,
+    kExtrasEmission = 1,  ///< SectionRef: +0 addr, +1 count
+    kExtrasEmitters = 3,
     kTriangleV0 = 0,
     kTriangleV1 = 3,
     kTriangleV2 = 6,
@@ -271,6 +312,14 @@ TRAX_LAYOUT_WORD(Camera, down, kCameraDown);
 TRAX_LAYOUT_WORD(PointLight, position, kLightPosition);
 TRAX_LAYOUT_WORD(PointLight, color, kLightColor);
 TRAX_LAYOUT_WORD(Material, diffuse, kMaterialDiffuse);
+TRAX_LAYOUT_WORD(Emission, radiance, kEmissionRadiance);
+TRAX_LAYOUT_WORD(Emitter, triangle, kEmitterTriangle);
+TRAX_LAYOUT_WORD(Emitter, area, kEmitterArea);
+TRAX_LAYOUT_WORD(Emitter, probability, kEmitterProbability);
+TRAX_LAYOUT_WORD(Emitter, cdf, kEmitterCdf);
+TRAX_LAYOUT_WORD(SceneExtras, seed, kExtrasSeed);
+TRAX_LAYOUT_WORD(SceneExtras, emission, kExtrasEmission);
+TRAX_LAYOUT_WORD(SceneExtras, emitters, kExtrasEmitters);
 TRAX_LAYOUT_WORD(Triangle, v0, kTriangleV0);
 TRAX_LAYOUT_WORD(Triangle, v1, kTriangleV1);
 TRAX_LAYOUT_WORD(Triangle, v2, kTriangleV2);
@@ -286,6 +335,7 @@ static_assert(sizeof(SectionRef) == 8);
 static_assert(sizeof(Camera) == 48);
 static_assert(sizeof(PointLight) == 24);
 static_assert(sizeof(Material) == 12);
+static_assert(sizeof(Emission) == 12 && sizeof(Emitter) == 16 && sizeof(SceneExtras) == 20);
 static_assert(sizeof(Triangle) == 40);
 static_assert(sizeof(BvhNode) == 32, "the BVH node is one half cache line");
 static_assert(sizeof(SceneHeader) == 124);
@@ -296,26 +346,39 @@ constexpr int32_t align_section(int32_t word) {
     return (word + kSectionAlignWords - 1) / kSectionAlignWords * kSectionAlignWords;
 }
 
+/// Word address of the SceneExtras record when the image has one: the first section.
+constexpr int32_t kExtrasAddr = align_section(kHeaderWords);
+
 /// THE section placement rule. Given a header whose counts (and image size) are filled in,
 /// assigns every section's addr and total_words: sections follow the header in the order
-/// camera, lights, materials, triangles, bvh_nodes, framebuffer, thread_stats, rays,
-/// ray_results, each aligned to
-/// kSectionAlignWords; empty sections take no space. The framebuffer count is set from the
-/// image size, the ray_results count from the rays count. The scene compiler calls this; tests
-/// check images against it.
-constexpr void place_sections(SceneHeader& h) {
+/// [extras], camera, lights, materials, [emission], triangles, [emitters], bvh_nodes,
+/// framebuffer, thread_stats, rays, ray_results, each aligned to kSectionAlignWords; empty
+/// sections take no space. The bracketed ones exist only with `extras` (its emitters count
+/// filled in; the emission count is set to the materials count); without it the image is laid
+/// out as if they did not exist. The framebuffer count is set from the image size, the
+/// ray_results count from the rays count. The scene compiler calls this; tests check images
+/// against it.
+constexpr void place_sections(SceneHeader& h, SceneExtras* extras = nullptr) {
     h.camera.count = 1;
     h.framebuffer.count = h.image_width * h.image_height;
     h.ray_results.count = h.rays.count;
+    SectionRef extras_record{0, 0}, no_emission{0, 0}, no_emitters{0, 0};
+    if (extras != nullptr) {
+        extras_record.count = 1;
+        extras->emission.count = h.materials.count;
+    }
     struct Section {
         SectionRef* ref;
         int32_t record_words;
     };
     const Section order[] = {
+        {&extras_record, kExtrasWords},
         {&h.camera, kCameraWords},
         {&h.lights, kPointLightWords},
         {&h.materials, kMaterialWords},
+        {extras ? &extras->emission : &no_emission, kEmissionWords},
         {&h.triangles, kTriangleWords},
+        {extras ? &extras->emitters : &no_emitters, kEmitterWords},
         {&h.bvh_nodes, kBvhNodeWords},
         {&h.framebuffer, kPixelWords},
         {&h.thread_stats, kThreadStatsWords},

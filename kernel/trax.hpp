@@ -111,6 +111,30 @@ TRAX_CSR_FUNCTION(trax_tm_size, 0xCC4)
         ".globl trax_uses_bvh\n.type trax_uses_bvh, @function\n"                                   \
         "trax_uses_bvh:\n  ret\n.size trax_uses_bvh, . - trax_uses_bvh\n.popsection")
 
+namespace trax::detail {
+/// Leaves the marker trax::layout::kUsesExtrasSymbol in the ELF (once per object file: .ifndef;
+/// weak, so objects may share it; kept by the link script). Called by every function that reads
+/// the SceneExtras record, so a kernel gets that record exactly when it uses it. No code.
+TRAX_INLINE void mark_uses_extras() {
+    asm volatile(".ifndef trax_uses_extras\n"
+                 ".pushsection .text.trax_uses_extras, \"ax\", @progbits\n"
+                 ".weak trax_uses_extras\n.type trax_uses_extras, @function\n"
+                 "trax_uses_extras:\n  ret\n.size trax_uses_extras, . - trax_uses_extras\n"
+                 ".popsection\n.endif");
+}
+/// trax_rand()'s state lives in the thread-pointer register tp (x4): private to the thread,
+/// 0 at start, never used by compiled code (the kernels have no thread-local variables).
+/// Volatile: the compiler does not know that trax_rand() changes it.
+TRAX_INLINE uint32_t rand_state() {
+    uint32_t state;
+    asm volatile("mv %0, tp" : "=r"(state));
+    return state;
+}
+TRAX_INLINE void set_rand_state(uint32_t state) {
+    asm volatile("mv tp, %0" : : "r"(state));
+}
+}  // namespace trax::detail
+
 #else  // the native twin
 
 #include <stdexcept>
@@ -129,6 +153,7 @@ struct ThreadContext {
     int64_t read_only_words = 0;           ///< the scene, words [0, read_only_words): stores fault
     uint32_t* global_registers = nullptr;  ///< kGlobalRegisters of them, all 0 at start
     int thread_id = 0, num_threads = 0, tm_id = 0, num_tms = 0, tp_id = 0, tm_size = 0;
+    uint32_t rand_state = 0;  ///< trax_rand()'s state (the guest keeps it in register tp)
 };
 constexpr int kGlobalRegisters = 256;
 
@@ -226,6 +251,16 @@ inline int trax_tm_size() {
     return trax::native::current->tm_size;
 }
 
+namespace trax::detail {
+inline void mark_uses_extras() {}  // the host reads the marker from the guest ELF
+inline uint32_t rand_state() {
+    return trax::native::current->rand_state;
+}
+inline void set_rand_state(uint32_t state) {
+    trax::native::current->rand_state = state;
+}
+}  // namespace trax::detail
+
 #endif
 
 // ---- Both sides from here on: written only in terms of the primitives above. ----------------
@@ -280,6 +315,67 @@ TRAX_INLINE int trax_num_bvh_nodes() {
 }
 TRAX_INLINE int trax_framebuffer() {
     return loadi(0, trax::layout::kHeaderFramebuffer);
+}
+
+// Emitters and the run seed: the SceneExtras record (scene_layout.hpp), which tpsim lays out
+// for a kernel that calls any of these (they leave a marker in its ELF; docs/kernel-api.md).
+/// The run's seed, `tpsim render --seed N` (default 0).
+TRAX_INLINE uint32_t trax_run_seed() {
+    trax::detail::mark_uses_extras();
+    return uint32_t(loadi(trax::layout::kExtrasAddr, trax::layout::kExtrasSeed));
+}
+/// Word address of the radiance (3 floats, linear RGB) a material emits; 0, 0, 0 for most.
+TRAX_INLINE int trax_emission(int material) {
+    trax::detail::mark_uses_extras();
+    return loadi(trax::layout::kExtrasAddr, trax::layout::kExtrasEmission) +
+           material * trax::layout::kEmissionWords;
+}
+/// Word address of the emitters section: one Emitter (triangle, area, probability, cdf) per
+/// emissive triangle, for light sampling.
+TRAX_INLINE int trax_emitters() {
+    trax::detail::mark_uses_extras();
+    return loadi(trax::layout::kExtrasAddr, trax::layout::kExtrasEmitters);
+}
+TRAX_INLINE int trax_num_emitters() {
+    trax::detail::mark_uses_extras();
+    return loadi(trax::layout::kExtrasAddr, trax::layout::kExtrasEmitters + 1);
+}
+
+// Random numbers: integer operations only, so both sides draw the same bits.
+/// A well-mixed 32-bit hash (lowbias32, C. Wellons' hash prospector): for seeds, e.g.
+/// trax_srand(trax_hash(trax_hash(pixel, sample), trax_run_seed())).
+TRAX_INLINE uint32_t trax_hash(uint32_t x) {
+    x ^= x >> 16;
+    x *= 0x7feb352du;
+    x ^= x >> 15;
+    x *= 0x846ca68bu;
+    x ^= x >> 16;
+    return x;
+}
+/// Two values hashed into one (order matters).
+TRAX_INLINE uint32_t trax_hash(uint32_t a, uint32_t b) {
+    return trax_hash(a ^ trax_hash(b));
+}
+/// Restarts this thread's sequence of trax_rand() numbers; the same seed gives the same numbers.
+TRAX_INLINE void trax_srand(uint32_t seed) {
+    const uint32_t state = trax_hash(seed);
+    trax::detail::set_rand_state(state != 0 ? state : 0x9e3779b9u);  // xorshift's state is never 0
+}
+/// Uniform float in [0, 1), 24 random bits: Marsaglia's xorshift32 (13, 17, 5), one state per
+/// thread. A thread that never called trax_srand() starts from trax_hash(thread id, run seed),
+/// so the numbers a pixel gets depend on which thread draws them: seed per pixel (and sample)
+/// for an image that does not depend on how atomicinc hands out the work.
+TRAX_INLINE float trax_rand() {
+    uint32_t x = trax::detail::rand_state();
+    if (x == 0) {  // the thread's first draw
+        trax_srand(trax_hash(uint32_t(trax_thread_id()), trax_run_seed()));
+        x = trax::detail::rand_state();
+    }
+    x ^= x << 13;
+    x ^= x >> 17;
+    x ^= x << 5;
+    trax::detail::set_rand_state(x);
+    return float(x >> 8) * 0x1p-24f;
 }
 
 // Float helpers that give the same bits on both sides: IEEE operations only, no libm.

@@ -1,5 +1,7 @@
 // `tpsim render SCENE`: renders a scene with a kernel on the simulated chip (or its native twin),
 // writes the image and prints the statistics.
+#include <charconv>
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -46,6 +48,19 @@ void print_kernel_output(const trax::KernelOutput& output) {
         fmt::print(stderr, "tpsim: warning: {}\n", note);
 }
 
+/// A whole number in [lo, hi], for the image overrides: the message says the limits.
+CLI::Validator whole_number_in(uint32_t lo, uint32_t hi) {
+    return CLI::Validator(
+        [lo, hi](std::string& value) -> std::string {
+            uint64_t number = 0;
+            const char* end = value.data() + value.size();
+            const auto [parsed_to, error] = std::from_chars(value.data(), end, number);
+            if (error == std::errc{} && parsed_to == end && number >= lo && number <= hi) return {};
+            return fmt::format("must be a whole number in [{}, {}], got '{}'", lo, hi, value);
+        },
+        fmt::format("{}..{}", lo, hi));
+}
+
 struct RenderCommandOptions {
     std::string scene;
     std::string up;
@@ -68,6 +83,7 @@ struct RenderCommandOptions {
     std::string html;
     uint64_t max_instructions = uint64_t(1) << 32;
     uint64_t max_item_instructions = 0;
+    uint32_t width = 0, height = 0, samples_per_pixel = 0, seed = 0;  // 0 size/spp: the scene's
 };
 
 int run_render(const RenderCommandOptions& o) {
@@ -90,6 +106,10 @@ int run_render(const RenderCommandOptions& o) {
     options.engine = o.native              ? render::Engine::native
                      : o.timing == "cycle" ? render::Engine::timing
                                            : render::Engine::functional;
+    options.image_width = o.width;
+    options.image_height = o.height;
+    options.samples_per_pixel = o.samples_per_pixel;
+    options.seed = o.seed;
     options.max_instructions = o.max_instructions;
     options.max_item_instructions = o.max_item_instructions;
     options.timeline_interval = o.timeline_cycles;
@@ -216,6 +236,21 @@ Command add_render_command(CLI::App& app) {
         ->capture_default_str();
     command->add_option("--max-leaf", o->max_leaf, "Most triangles in one BVH leaf")
         ->check(CLI::Range(1, 8))
+        ->capture_default_str();
+    // The same limits as the scene file's [image] keys (docs/scenes.md).
+    command->add_option("--width", o->width, "Image width in pixels, instead of the scene's")
+        ->check(whole_number_in(1, 16384));
+    command->add_option("--height", o->height, "Image height in pixels, instead of the scene's")
+        ->check(whole_number_in(1, 16384));
+    command
+        ->add_option("--spp", o->samples_per_pixel,
+                     "Samples per pixel, instead of the scene's samples_per_pixel")
+        ->check(whole_number_in(1, 65536));
+    command
+        ->add_option("--seed", o->seed,
+                     "Run seed for the kernel's random numbers (trax_run_seed(), the default "
+                     "seeding of trax_rand())")
+        ->check(whole_number_in(0, UINT32_MAX))
         ->capture_default_str();
     command->add_flag("--native", o->native,
                       "Run the kernel's native twin on the host instead of the simulator");

@@ -71,10 +71,40 @@ std::vector<layout::BvhNode> compile_bvh(const scene::Bvh& bvh) {
     return out;
 }
 
+/// The emissive triangles of the image (in image order), each picked with probability
+/// proportional to its power, area times mean radiance; zero-area triangles are left out.
+std::vector<layout::Emitter> compile_emitters(const std::vector<layout::Triangle>& triangles,
+                                              const std::vector<scene::Material>& materials) {
+    std::vector<layout::Emitter> emitters;
+    std::vector<double> power;
+    for (size_t i = 0; i < triangles.size(); ++i) {
+        const layout::Triangle& t = triangles[i];
+        const glm::vec3 e = materials[size_t(t.material)].emission;
+        const double radiance = (double(e.x) + double(e.y) + double(e.z)) / 3;
+        const glm::dvec3 v0(t.v0[0], t.v0[1], t.v0[2]), v1(t.v1[0], t.v1[1], t.v1[2]),
+            v2(t.v2[0], t.v2[1], t.v2[2]);
+        const double area = 0.5 * glm::length(glm::cross(v1 - v0, v2 - v0));
+        if (radiance == 0 || area == 0) continue;
+        emitters.push_back({int32_t(i), float(area), 0.f, 0.f});
+        power.push_back(area * radiance);
+    }
+    double total = 0;
+    for (double p : power)
+        total += p;
+    double sum = 0;
+    for (size_t i = 0; i < emitters.size(); ++i) {
+        sum += power[i];
+        emitters[i].probability = float(power[i] / total);
+        emitters[i].cdf = i + 1 == emitters.size() ? 1.f : float(sum / total);
+    }
+    return emitters;
+}
+
 }  // namespace
 
 MemoryImage build_memory_image(const scene::Scene& scene, const scene::Bvh* bvh, uint32_t threads,
-                               std::span<const layout::Ray> rays) {
+                               std::span<const layout::Ray> rays,
+                               std::optional<uint32_t> extras_seed) {
     if (scene.width == 0 || scene.height == 0)
         throw Error("scene has an empty image (width or height is 0)");
     if (scene.triangles.empty()) throw Error("scene has no triangles");
@@ -115,7 +145,11 @@ MemoryImage build_memory_image(const scene::Scene& scene, const scene::Bvh* bvh,
         uint64_t(h.triangles.count) * layout::kTriangleWords +
         uint64_t(h.bvh_nodes.count) * layout::kBvhNodeWords + pixels * layout::kPixelWords +
         uint64_t(threads) * layout::kThreadStatsWords +
-        uint64_t(rays.size()) * (layout::kRayWords + layout::kRayResultWords) + 4096;
+        uint64_t(rays.size()) * (layout::kRayWords + layout::kRayResultWords) +
+        (extras_seed ? uint64_t(h.triangles.count) * layout::kEmitterWords +
+                           uint64_t(h.materials.count) * layout::kEmissionWords
+                     : 0) +
+        4096;
     // Global memory spans kGlobalBase..kLocalTop - kStackGuard in the guest address space.
     constexpr uint64_t kMaxWords =
         (trax::map::kLocalTop - trax::map::kStackGuard - trax::map::kGlobalBase) / 4;
@@ -123,11 +157,45 @@ MemoryImage build_memory_image(const scene::Scene& scene, const scene::Bvh* bvh,
         throw Error(fmt::format("scene needs about {} MiB of global memory; the address map has "
                                 "room for {} MiB (reduce the image size or the mesh)",
                                 estimate * 4 >> 20, kMaxWords * 4 >> 20));
-    layout::place_sections(h);
+    // Triangles in image order: with a BVH, leaves index contiguous runs of them (leaf order).
+    std::vector<layout::Triangle> triangles;
+    triangles.reserve(scene.triangles.size());
+    for (size_t i = 0; i < scene.triangles.size(); ++i) {
+        const scene::Triangle& t = scene.triangles[bvh ? bvh->triangle_order[i] : i];
+        if (t.material >= scene.materials.size())
+            throw Error(fmt::format("triangle {} uses material {} but the scene has {}", i,
+                                    t.material, scene.materials.size()));
+        layout::Triangle tri{};
+        put(tri.v0, t.v0);
+        put(tri.v1, t.v1);
+        put(tri.v2, t.v2);
+        tri.material = int32_t(t.material);
+        triangles.push_back(tri);
+    }
+    layout::SceneExtras extras{};
+    std::vector<layout::Emitter> emitters;
+    if (extras_seed) {
+        extras.seed = *extras_seed;
+        emitters = compile_emitters(triangles, scene.materials);
+        extras.emitters.count = checked_count(emitters.size(), "emitters");
+    }
+    layout::place_sections(h, extras_seed ? &extras : nullptr);
 
     MemoryImage image;
     image.words.assign(size_t(h.total_words), 0u);
     write(image.words, 0, h);
+    if (extras_seed) {
+        write(image.words, layout::kExtrasAddr, extras);
+        for (size_t i = 0; i < scene.materials.size(); ++i) {
+            layout::Emission emission{};
+            put(emission.radiance, scene.materials[i].emission);
+            write(image.words, extras.emission.addr + int32_t(i) * layout::kEmissionWords,
+                  emission);
+        }
+        for (size_t i = 0; i < emitters.size(); ++i)
+            write(image.words, extras.emitters.addr + int32_t(i) * layout::kEmitterWords,
+                  emitters[i]);
+    }
     write(image.words, h.camera.addr, compile_camera(scene.camera, scene.width, scene.height));
     for (size_t i = 0; i < scene.lights.size(); ++i) {
         layout::PointLight light{};
@@ -140,19 +208,8 @@ MemoryImage build_memory_image(const scene::Scene& scene, const scene::Bvh* bvh,
         put(material.diffuse, scene.materials[i].diffuse);
         write(image.words, h.materials.addr + int32_t(i) * layout::kMaterialWords, material);
     }
-    for (size_t i = 0; i < scene.triangles.size(); ++i) {
-        // With a BVH, leaves index contiguous runs of triangles: store them in leaf order.
-        const scene::Triangle& t = scene.triangles[bvh ? bvh->triangle_order[i] : i];
-        if (t.material >= scene.materials.size())
-            throw Error(fmt::format("triangle {} uses material {} but the scene has {}", i,
-                                    t.material, scene.materials.size()));
-        layout::Triangle tri{};
-        put(tri.v0, t.v0);
-        put(tri.v1, t.v1);
-        put(tri.v2, t.v2);
-        tri.material = int32_t(t.material);
-        write(image.words, h.triangles.addr + int32_t(i) * layout::kTriangleWords, tri);
-    }
+    for (size_t i = 0; i < triangles.size(); ++i)
+        write(image.words, h.triangles.addr + int32_t(i) * layout::kTriangleWords, triangles[i]);
     for (size_t i = 0; i < nodes.size(); ++i)
         write(image.words, h.bvh_nodes.addr + int32_t(i) * layout::kBvhNodeWords, nodes[i]);
     for (size_t i = 0; i < rays.size(); ++i)
@@ -163,18 +220,24 @@ MemoryImage build_memory_image(const scene::Scene& scene, const scene::Bvh* bvh,
                            uint64_t(ref.addr) * 4};
     };
     image.header = h;
-    image.sections = {
-        {"header", 1, sizeof(layout::SceneHeader)},
-        section("camera", h.camera, layout::kCameraWords),
-        section("lights", h.lights, layout::kPointLightWords),
-        section("materials", h.materials, layout::kMaterialWords),
-        section("triangles", h.triangles, layout::kTriangleWords),
-        section("bvh_nodes", h.bvh_nodes, layout::kBvhNodeWords),
-        section("framebuffer", h.framebuffer, layout::kPixelWords),
-        section("thread_stats", h.thread_stats, layout::kThreadStatsWords),
-        section("rays", h.rays, layout::kRayWords),
-        section("ray_results", h.ray_results, layout::kRayResultWords),
-    };
+    // The extras' sections are listed only when present, so an image without them reports
+    // (and registers statistics for) exactly the sections it always had.
+    image.sections = {{"header", 1, sizeof(layout::SceneHeader)}};
+    if (extras_seed)
+        image.sections.push_back({"extras", 1, sizeof(extras), layout::kExtrasAddr * 4});
+    image.sections.push_back(section("camera", h.camera, layout::kCameraWords));
+    image.sections.push_back(section("lights", h.lights, layout::kPointLightWords));
+    image.sections.push_back(section("materials", h.materials, layout::kMaterialWords));
+    if (extras_seed)
+        image.sections.push_back(section("emission", extras.emission, layout::kEmissionWords));
+    image.sections.push_back(section("triangles", h.triangles, layout::kTriangleWords));
+    if (extras_seed)
+        image.sections.push_back(section("emitters", extras.emitters, layout::kEmitterWords));
+    image.sections.push_back(section("bvh_nodes", h.bvh_nodes, layout::kBvhNodeWords));
+    image.sections.push_back(section("framebuffer", h.framebuffer, layout::kPixelWords));
+    image.sections.push_back(section("thread_stats", h.thread_stats, layout::kThreadStatsWords));
+    image.sections.push_back(section("rays", h.rays, layout::kRayWords));
+    image.sections.push_back(section("ray_results", h.ray_results, layout::kRayResultWords));
     return image;
 }
 

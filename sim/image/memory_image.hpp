@@ -2,6 +2,7 @@
 // image defined by kernel/scene_layout.hpp, holding only the sections the scene needs.
 #pragma once
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -36,10 +37,13 @@ struct MemoryImage {
 /// Lays the scene out. With a BVH, triangles are stored in leaf order and nodes with sibling
 /// pairs adjacent, as the traversal kernel expects; without one, the BVH section is left out.
 /// One zeroed ThreadStats record per thread (`threads` of them); `rays` (for the ray_query
-/// kernel) and room for as many RayResults. Throws tpsim::Error if the scene does not fit the
-/// layout (e.g. more than 2^31 words).
+/// kernel) and room for as many RayResults. With `extras_seed`, also the SceneExtras record
+/// (that run seed, every material's emission, the emissive triangles): only for kernels that
+/// read it (their ELF defines trax::layout::kUsesExtrasSymbol). Throws tpsim::Error if the
+/// scene does not fit the layout (e.g. more than 2^31 words).
 MemoryImage build_memory_image(const scene::Scene& scene, const scene::Bvh* bvh, uint32_t threads,
-                               std::span<const trax::layout::Ray> rays = {});
+                               std::span<const trax::layout::Ray> rays = {},
+                               std::optional<uint32_t> extras_seed = std::nullopt);
 
 /// The kernel's per-thread statistics records summed (ThreadStats; max for the depth).
 struct TraversalTotals {

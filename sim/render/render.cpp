@@ -46,10 +46,18 @@ Kernel Kernel::load(const std::filesystem::path& elf) {
     return {elf, core::load_elf(elf.string())};
 }
 
-bool Kernel::uses_bvh() const {
+bool Kernel::defines(std::string_view symbol_name) const {
     for (const core::Symbol& symbol : program.functions)
-        if (symbol.name == trax::layout::kUsesBvhSymbol) return true;
+        if (symbol.name == symbol_name) return true;
     return false;
+}
+
+bool Kernel::uses_bvh() const {
+    return defines(trax::layout::kUsesBvhSymbol);
+}
+
+bool Kernel::uses_extras() const {
+    return defines(trax::layout::kUsesExtrasSymbol);
 }
 
 uint64_t default_item_instructions(const scene::Scene& scene) {
@@ -104,7 +112,9 @@ RenderResult render(const RenderOptions& options) {
         result.bvh = bvh->stats;
     }
     result.threads = options.chip.chip.num_tms * options.chip.chip.tps_per_tm;
-    result.image = image::build_memory_image(result.scene, bvh ? &*bvh : nullptr, result.threads);
+    result.image = image::build_memory_image(
+        result.scene, bvh ? &*bvh : nullptr, result.threads, {},
+        kernel.uses_extras() ? std::optional(options.seed) : std::nullopt);
 
     const uint64_t item_limit = options.max_item_instructions != 0
                                     ? options.max_item_instructions

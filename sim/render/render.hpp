@@ -7,6 +7,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <string_view>
 #include <vector>
 
 #include "isa/isa.hpp"
@@ -51,6 +52,10 @@ struct Kernel {
     static Kernel load(const std::filesystem::path& elf);
     /// Does the kernel traverse a BVH (define trax::layout::kUsesBvhSymbol)?
     bool uses_bvh() const;
+    /// Does the kernel read the SceneExtras record (define trax::layout::kUsesExtrasSymbol)?
+    bool uses_extras() const;
+    /// Does the ELF define a function (or code label) of this name?
+    bool defines(std::string_view symbol_name) const;
 };
 
 struct RenderOptions {
@@ -62,10 +67,13 @@ struct RenderOptions {
     /// marker); other kernels get no BVH in their memory image. render() sets the depth limit
     /// to the kernels' stack capacity (trax::layout::kTraversalStackEntries).
     scene::BvhConfig bvh;
-    /// Overrides the scene file's image size when non-zero (tests render small images).
-    uint32_t image_width = 0, image_height = 0;
-    uint32_t samples_per_pixel = 0;  ///< overrides the scene file's samples when non-zero
-    timing::ChipConfig chip;         ///< shape (TMs x TPs) and local-store size
+    /// Override the scene file's image size and samples per pixel when non-zero
+    /// (render --width/--height/--spp; tests render small images).
+    uint32_t image_width = 0, image_height = 0, samples_per_pixel = 0;
+    /// The run seed trax_rand() mixes into its default seeding (render --seed); reaches the
+    /// kernel in the SceneExtras record, which only kernels that read it get.
+    uint32_t seed = 0;
+    timing::ChipConfig chip;                        ///< shape (TMs x TPs) and local-store size
     uint64_t max_instructions = uint64_t(1) << 32;  ///< per thread, for runaway kernels
     /// Per work item (core::MachineConfig::max_item_instructions), for runaway kernels;
     /// 0: default_item_instructions(scene).

@@ -205,9 +205,18 @@ void register_stats(const RenderResult& r, stats::Registry& reg) {
 }
 
 void print_summary(const RenderOptions& options, const RenderResult& r, std::ostream& out) {
-    fmt::print(out, "scene    {} ({} triangles, {} lights, {} materials), {}x{} pixels, {} spp\n",
+    // What the command line overrode is marked, and the seed shown to kernels that read it.
+    const auto overridden = [](uint32_t value) { return value != 0 ? " (set by option)" : ""; };
+    const bool has_extras =
+        std::any_of(r.image.sections.begin(), r.image.sections.end(),
+                    [](const image::SectionSize& s) { return s.name == "extras"; });
+    fmt::print(out,
+               "scene    {} ({} triangles, {} lights, {} materials), {}x{} pixels{}, {} spp{}{}\n",
                options.scene.string(), r.scene.triangles.size(), r.scene.lights.size(),
-               r.scene.materials.size(), r.scene.width, r.scene.height, r.scene.samples_per_pixel);
+               r.scene.materials.size(), r.scene.width, r.scene.height,
+               overridden(options.image_width | options.image_height), r.scene.samples_per_pixel,
+               overridden(options.samples_per_pixel),
+               has_extras ? fmt::format(", seed {}", options.seed) : "");
     fmt::print(out, "kernel   {} on {} ({} TMs x {} TPs = {} threads)\n",
                display_path(options.kernel),
                options.engine == Engine::native   ? "the native twin"
@@ -293,6 +302,7 @@ nlohmann::ordered_json stats_document(const RenderOptions& options, const Render
     run["width"] = r.scene.width;
     run["height"] = r.scene.height;
     run["samples_per_pixel"] = r.scene.samples_per_pixel;
+    run["seed"] = options.seed;
     run["threads"] = r.threads;
     run["image"] = relative(outputs.image);
     if (!outputs.heatmap.empty()) run["heatmap"] = relative(outputs.heatmap);

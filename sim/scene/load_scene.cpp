@@ -224,7 +224,9 @@ public:
     uint32_t intern(const Material& material) {
         if (auto index = defined(material.name)) return *index;
         for (uint32_t i = defined_; i < list_.size(); ++i)
-            if (list_[i].name == material.name && list_[i].diffuse == material.diffuse) return i;
+            if (list_[i].name == material.name && list_[i].diffuse == material.diffuse &&
+                list_[i].emission == material.emission)
+                return i;
         list_.push_back(material);
         return uint32_t(list_.size() - 1);
     }
@@ -615,6 +617,17 @@ struct Geometry {
     }
 };
 
+/// `name = [r, g, b]` (the diffuse albedo) or `name = { diffuse = [r, g, b], emission = [r, g, b]
+/// }`.
+Material read_material(const Reader& r, const toml::node& value, const std::string& name) {
+    const std::string prefix = join("materials", name);
+    if (!value.is_table()) return {name, r.vec3(value, prefix, kUnit)};
+    const toml::table& t = *value.as_table();
+    r.allow_keys(t, prefix, {"diffuse", "emission"});
+    return {name, r.vec3(t, prefix, "diffuse", kUnit, kDefaultMaterial.diffuse),
+            r.vec3(t, prefix, "emission", kFloatNonNegative, glm::vec3(0.f))};
+}
+
 void read_mesh(const Reader& r, const toml::table& t, const std::string& prefix,
                const std::filesystem::path& base, MaterialTable& materials, Scene& scene,
                Geometry& geometry) {
@@ -811,8 +824,7 @@ Scene load_scene_file(const std::filesystem::path& toml_path) {
     MaterialTable materials;
     if (const toml::node* node = root.get("materials"))
         for (auto&& [name, value] : r.table(*node, "materials"))
-            materials.define(
-                {std::string(name.str()), r.vec3(value, join("materials", name.str()), kUnit)});
+            materials.define(read_material(r, value, std::string(name.str())));
 
     // Camera and lights are read before the geometry so their mistakes are reported even when
     // a mesh is missing too; their defaults need the geometry's bounds, so they come last.

@@ -30,13 +30,23 @@ bool is_finite(const glm::vec3& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
-Material convert_material(const aiMaterial& source) {
+Material convert_material(const aiMaterial& source, const std::string& where) {
     Material material;
     aiString name;
     if (source.Get(AI_MATKEY_NAME, name) == AI_SUCCESS) material.name = name.C_Str();
     aiColor3D diffuse;
     if (source.Get(AI_MATKEY_COLOR_DIFFUSE, diffuse) == AI_SUCCESS)
         material.diffuse = {diffuse.r, diffuse.g, diffuse.b};
+    // An OBJ's .mtl `Ke`: the radiance the material emits, straight to the kernel as float.
+    aiColor3D emission;
+    if (source.Get(AI_MATKEY_COLOR_EMISSIVE, emission) == AI_SUCCESS) {
+        material.emission = {emission.r, emission.g, emission.b};
+        if (!is_finite(material.emission) || material.emission.x < 0.f ||
+            material.emission.y < 0.f || material.emission.z < 0.f)
+            throw Error(fmt::format("{}: material '{}' emits ({}, {}, {}) (.mtl Ke): each "
+                                    "channel must be a finite number >= 0 within float range",
+                                    where, material.name, emission.r, emission.g, emission.b));
+    }
     return material;
 }
 
@@ -482,7 +492,7 @@ ImportedMesh import_mesh(const std::filesystem::path& path) {
     ImportedMesh mesh;
     mesh.summary.source = where;
     for (unsigned m = 0; m < file->mNumMaterials; ++m)
-        mesh.materials.push_back(convert_material(*file->mMaterials[m]));
+        mesh.materials.push_back(convert_material(*file->mMaterials[m], where));
     if (mesh.materials.empty()) mesh.materials.push_back(Material{"default", glm::vec3(0.8f)});
 
     for (unsigned m = 0; m < file->mNumMeshes; ++m) {

@@ -48,8 +48,10 @@ void generate_sphere(const SphereParams& p, uint32_t material, std::vector<Trian
             const glm::vec3 a = point(ring, s), b = point(ring, s + 1);
             const glm::vec3 c = point(ring + 1, s), d = point(ring + 1, s + 1);
             // The pole rows collapse to a point, so they get one triangle per segment, not two.
-            if (ring != 0) out.push_back({a, d, b, material});
-            if (ring + 1 != p.rings) out.push_back({a, c, d, material});
+            // Counter-clockwise seen from outside: the normal (v1 - v0) x (v2 - v0) points out,
+            // the side an emissive sphere emits from.
+            if (ring != 0) out.push_back({a, b, d, material});
+            if (ring + 1 != p.rings) out.push_back({a, d, c, material});
         }
 }
 

@@ -17,6 +17,7 @@ struct Triangle {
 struct Material {
     std::string name;
     glm::vec3 diffuse{0.8f};
+    glm::vec3 emission{0.f};  ///< emitted radiance, linear RGB (an area light when not 0)
 };
 
 struct PointLight {
