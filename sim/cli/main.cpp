@@ -18,7 +18,8 @@ int main(int argc, char** argv) {
     app.require_subcommand(0, 1);
     const tpsim::cli::Command commands[] = {
         tpsim::cli::add_render_command(app), tpsim::cli::add_exec_command(app),
-        tpsim::cli::add_compare_command(app), tpsim::cli::add_report_command(app)};
+        tpsim::cli::add_compare_command(app), tpsim::cli::add_report_command(app),
+        tpsim::cli::add_new_kernel_command(app)};
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -33,7 +34,8 @@ int main(int argc, char** argv) {
     }
     if (app.get_subcommands().empty()) {
         fmt::print(stderr,
-                   "tpsim: give a subcommand: render, exec, compare or report (tpsim --help)\n");
+                   "tpsim: give a subcommand: render, exec, compare, report or new-kernel (tpsim "
+                   "--help)\n");
         return 2;
     }
     int status = 0;

@@ -73,7 +73,8 @@ std::filesystem::path native_twin_of(const std::filesystem::path& kernel_elf) {
 }
 
 void run_native_twin(const std::filesystem::path& library, std::vector<uint32_t>& global_words,
-                     uint32_t num_threads, uint32_t num_tms, uint32_t tm_size) {
+                     uint32_t num_threads, uint32_t num_tms, uint32_t tm_size,
+                     TwinProcess process) {
     // RTLD_LOCAL keeps each twin's copy of the trax runtime to itself.
     const std::unique_ptr<void, int (*)(void*)> handle(
         dlopen(std::filesystem::absolute(library).c_str(), RTLD_NOW | RTLD_LOCAL), dlclose);
@@ -86,6 +87,23 @@ void run_native_twin(const std::filesystem::path& library, std::vector<uint32_t>
     if (run == nullptr)
         throw Error(fmt::format("'{}' is not a tpsim native twin (no {} symbol)", library.string(),
                                 TPSIM_NATIVE_RUN_SYMBOL));
+
+    if (process == TwinProcess::in_process) {
+        // Straight on tpsim's memory: a crash is the debugger's to catch, and there is no time
+        // limit, so a thread can stay at a breakpoint for as long as it takes.
+        char error[kErrorBytes] = {};
+        const TraxNativeContext context{global_words.data(),
+                                        uint32_t(global_words.size()),
+                                        num_threads,
+                                        num_tms,
+                                        tm_size,
+                                        error,
+                                        kErrorBytes};
+        if (run(&context) != 0)
+            throw Error(error[0] != '\0' ? std::string(error)
+                                         : "the native twin failed without saying why");
+        return;
+    }
 
     // The twin is the student's code running on the host: a wild pointer or runaway recursion
     // there is a real SIGSEGV. It runs in a child process over shared memory so that such a
@@ -113,7 +131,8 @@ void run_native_twin(const std::filesystem::path& library, std::vector<uint32_t>
     if (WIFSIGNALED(status))
         throw Error(fmt::format(
             "the native twin '{}' stopped: {}; run without --native to have the simulator "
-            "name the thread, pc and source line, or debug the twin with gdb",
+            "name the thread, pc and source line, or run the twin in gdb with --no-fork "
+            "(docs/debugging.md)",
             library.filename().string(), describe_signal(WTERMSIG(status))));
     if (WEXITSTATUS(status) != 0)
         throw Error(error[0] != '\0' ? std::string(error, strnlen(error, kErrorBytes))
