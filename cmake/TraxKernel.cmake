@@ -199,7 +199,11 @@ function(_trax_compile obj src)
     set(flags ${TRAX_KERNEL_CXX_FLAGS} ${ARGN})
   endif()
   get_filename_component(dir "${obj}" DIRECTORY)
+  # The project's own files by their path in it, tpsim's runtime by its path in tpsim's tree.
   file(RELATIVE_PATH shown "${CMAKE_SOURCE_DIR}" "${src}")
+  if(shown MATCHES "^\\.\\./")
+    file(RELATIVE_PATH shown "${TRAX_KERNEL_DIR}/.." "${src}")
+  endif()
   add_custom_command(
     OUTPUT "${obj}"
     COMMAND "${CMAKE_COMMAND}" -E make_directory "${dir}"
