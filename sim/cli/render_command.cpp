@@ -130,8 +130,7 @@ int run_render(const RenderCommandOptions& o) {
                                            : render::Engine::functional;
     if (o.no_fork && !o.native)
         throw Error("--no-fork runs the native twin in tpsim's own process: give --native too");
-    options.twin_process =
-        o.no_fork ? render::TwinProcess::in_process : render::TwinProcess::child;
+    options.twin_process = o.no_fork ? render::TwinProcess::in_process : render::TwinProcess::child;
     options.max_instructions = o.max_instructions;
     options.max_item_instructions = o.max_item_instructions;
     options.timeline_interval = o.timeline_cycles;

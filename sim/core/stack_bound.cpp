@@ -14,6 +14,8 @@ namespace {
 
 constexpr uint8_t kRa = 1;  // x1, the link register: rd of a call
 constexpr uint8_t kX0 = isa::kSink;
+/// Longest call chain walked; the walk recurses once per call, on the host stack.
+constexpr size_t kMaxChain = 4096;
 
 /// What one function does with the stack: its frame and whom it calls.
 struct Calls {
@@ -85,6 +87,10 @@ public:
         if (!function || function->address != address || function->size == 0) {
             reason_ =
                 fmt::format("a call goes to {:#x}, which is not the start of a function", address);
+            return std::nullopt;
+        }
+        if (path_.size() >= kMaxChain) {  // only a damaged or generated ELF nests this deep
+            reason_ = fmt::format("its calls nest more than {} deep", kMaxChain);
             return std::nullopt;
         }
         if (std::find(path_.begin(), path_.end(), address) != path_.end()) {

@@ -141,9 +141,9 @@ RenderResult render(const RenderOptions& options) {
                 profile_of(result.timing->chip->profile(), kernel.program));
         result.instructions = result.timing->instructions;
     } else {
-        result.instructions = run_kernel(kernel, options.engine, result.image, options.chip,
-                                         options.max_instructions, item_limit,
-                                         options.twin_process);
+        result.instructions =
+            run_kernel(kernel, options.engine, result.image, options.chip, options.max_instructions,
+                       item_limit, options.twin_process);
     }
     result.run_seconds = seconds_since(start);
     result.traversal = image::read_thread_stats(result.image.header, result.image.words.data());

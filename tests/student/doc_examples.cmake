@@ -30,8 +30,8 @@ if(count EQUAL 0)
 endif()
 file(WRITE "${WORK}/CMakeLists.txt" "${cmake_lists}")
 
-execute_process(COMMAND "${CMAKE_COMMAND}" -S "${WORK}" -B "${WORK}/build" "-Dtpsim_DIR=${TPSIM_BUILD}"
-                RESULT_VARIABLE rc OUTPUT_VARIABLE log ERROR_VARIABLE log)
+execute_process(COMMAND "${CMAKE_COMMAND}" -S "${WORK}" -B "${WORK}/build"
+                        "-Dtpsim_DIR=${TPSIM_BUILD}" RESULT_VARIABLE rc OUTPUT_VARIABLE log ERROR_VARIABLE log)
 if(rc EQUAL 0)
   execute_process(COMMAND "${CMAKE_COMMAND}" --build "${WORK}/build"
                   RESULT_VARIABLE rc OUTPUT_VARIABLE log ERROR_VARIABLE log)
