@@ -36,17 +36,18 @@ std::optional<uint32_t> word_at(const Program& program, uint32_t pc) {
 Calls calls_of(const Program& program, const Symbol& function) {
     Calls out;
     const uint32_t end = function.address + function.size;
-    std::optional<uint32_t> auipc_value;  // of the instruction before, in register auipc_reg
+    // The value the instruction before put in auipc_reg, if it was an auipc (kNoReg: it was not).
+    uint32_t auipc_value = 0;
     uint8_t auipc_reg = isa::kNoReg;
     for (uint32_t pc = function.address; pc < end; pc += 4) {
         const std::optional<uint32_t> word = word_at(program, pc);
         if (!word) break;
         const isa::Decoded d = isa::decode(*word);
-        const bool from_auipc = auipc_value && d.rs1 == auipc_reg;
+        const bool from_auipc = auipc_reg != isa::kNoReg && d.rs1 == auipc_reg;
         if (d.op == isa::Op::jal || d.op == isa::Op::jalr) {
             std::optional<uint32_t> target;
             if (d.op == isa::Op::jal) target = pc + uint32_t(d.imm);
-            if (d.op == isa::Op::jalr && from_auipc) target = *auipc_value + uint32_t(d.imm);
+            if (d.op == isa::Op::jalr && from_auipc) target = auipc_value + uint32_t(d.imm);
             const bool is_return = d.op == isa::Op::jalr && d.rd == kX0 && d.rs1 == kRa;
             const bool local = target && *target >= function.address && *target < end;
             if (d.rd == kRa) {
@@ -64,11 +65,8 @@ Calls calls_of(const Program& program, const Symbol& function) {
                                           demangle(function.name), pc);
             }
         }
-        auipc_value.reset();
-        if (d.op == isa::Op::auipc) {
-            auipc_value = pc + uint32_t(d.imm);
-            auipc_reg = d.rd;
-        }
+        auipc_reg = d.op == isa::Op::auipc ? d.rd : isa::kNoReg;
+        auipc_value = pc + uint32_t(d.imm);
     }
     return out;
 }
