@@ -2,6 +2,9 @@
 #
 #   add_trax_kernel(NAME SOURCES a.cpp [b.cpp ...])
 #
+# in tpsim's own tree, or in any other project after find_package(tpsim) (tpsimConfig.cmake in
+# tpsim's build directory includes this file; `tpsim new-kernel DIR` writes such a project).
+#
 # makes
 #   ${CMAKE_BINARY_DIR}/kernels/NAME.elf            target NAME_elf (in ALL): RV32IMF, for tpsim
 #   ${CMAKE_BINARY_DIR}/kernels/libNAME_native.so   target NAME_native: the native twin, exporting
@@ -60,35 +63,62 @@ if(CMAKE_SCRIPT_MODE_FILE AND DEFINED TRAX_CHECK_KERNEL)
   list(REMOVE_ITEM undefined ${defined})
   list(REMOVE_DUPLICATES vtables)
 
-  # Which functions reference a symbol: with -ffunction-sections every function has its own
-  # section .text.<mangled name>, and the relocation listing names the section.
+  # Which functions reference a symbol, and from which source line: with -ffunction-sections
+  # every function has its own section .text.<mangled name>; the disassembly with -l names the
+  # source line (of the inlined code, too) above the instructions, -r the relocations below them.
   set(users_of_all "")
   foreach(obj IN LISTS TRAX_CHECK_OBJECTS)
-    execute_process(COMMAND "${TRAX_OBJDUMP}" -r "${obj}" OUTPUT_VARIABLE relocs)
-    string(REPLACE "\n" ";" relocs "${relocs}")
+    # (ERROR_QUIET: llvm-objdump 14 warns that it cannot apply the DWARF's R_RISCV_SET8 and
+    # friends; the line table it needs does not use them.)
+    execute_process(COMMAND "${TRAX_OBJDUMP}" -d -r -l --no-show-raw-insn "${obj}"
+                    OUTPUT_VARIABLE listing ERROR_QUIET)
+    # ';' starts the line comments and would split CMake's list; brackets would stop it splitting.
+    string(REPLACE ";" "#" listing "${listing}")
+    string(REPLACE "[" "(" listing "${listing}")
+    string(REPLACE "]" ")" listing "${listing}")
+    string(REPLACE "\n" ";" listing "${listing}")
     set(function "")
-    foreach(line IN LISTS relocs)
-      if(line MATCHES "^RELOCATION RECORDS FOR \\[(\\.rela?)?\\.text\\.(.+)\\]")
+    set(where "")
+    foreach(line IN LISTS listing)
+      if(line MATCHES "^Disassembly of section (\\.text\\.(.+)|.*):$")
         set(function "${CMAKE_MATCH_2}")
-      elseif(line MATCHES "^RELOCATION RECORDS FOR")
-        set(function "")
-      elseif(function AND line MATCHES "^[0-9a-f]+ +[A-Z0-9_]+ +([^ +]+)")
+        set(where "")
+      elseif(line MATCHES "^# (.*/)?([^/]+):([0-9]+)$")
+        set(where " at ${CMAKE_MATCH_2}:${CMAKE_MATCH_3}")
+      elseif(function AND line MATCHES "^[ \t]+[0-9a-f]+: +R_[A-Z0-9_]+[ \t]+([^ +]+)")
         set(sym "${CMAKE_MATCH_1}")
-        list(APPEND "users_of_${sym}" "${function}")
+        list(APPEND "users_of_${sym}" "${function}|${where}")
         list(APPEND users_of_all "${sym}")
       endif()
     endforeach()
   endforeach()
 
-  # "sym (from f(), g())" for the message.
+  # "sym, called from f() at a.cpp:5, g() at b.cpp:9" for the message.
   function(_trax_describe out sym)
     _trax_demangle(name "${sym}")
     set(users "${users_of_${sym}}")
     if(users)
       list(REMOVE_DUPLICATES users)
-      _trax_demangle(users ${users})
-      list(JOIN users ", " users)
-      set(name "${name}, called from ${users}")
+      set(functions "")
+      set(places "")
+      foreach(user IN LISTS users)
+        string(REPLACE "|" ";" user "${user}")
+        list(GET user 0 function)
+        list(LENGTH user fields)
+        set(place "")
+        if(fields GREATER 1)
+          list(GET user 1 place)
+        endif()
+        list(APPEND functions "${function}")
+        list(APPEND places "${place}")
+      endforeach()
+      _trax_demangle(functions ${functions})
+      set(described "")
+      foreach(function place IN ZIP_LISTS functions places)
+        list(APPEND described "${function}${place}")
+      endforeach()
+      list(JOIN described ", " described)
+      set(name "${name}, called from ${described}")
     endif()
     set(${out} "${name}" PARENT_SCOPE)
   endfunction()
@@ -150,10 +180,15 @@ set(TRAX_KERNEL_TARGET_FLAGS
 # memcpy/memset/memmove/memcmp for struct copies and clears, which kernel/runtime provides.
 # -ffunction-sections lets the checker name the function that uses a forbidden symbol.
 # -ffp-contract=off on both sides so the native twin rounds exactly like the guest.
+# -Werror=implicit-float-conversion catches a double result narrowed to float (`float x = p * 0.5`),
+# -Werror=double-promotion a float widened to double (`f * 0.5`). For the stack bound
+# (sim/core/stack_bound.hpp): -fstack-size-section records every function's frame, -Werror=vla
+# keeps every frame's size fixed, -fno-jump-tables leaves no jump whose target is unknown.
 set(TRAX_KERNEL_CXX_FLAGS
     ${TRAX_KERNEL_TARGET_FLAGS} -std=c++20 -O2 -ffreestanding -fno-exceptions -fno-rtti
     -fno-math-errno -ffp-contract=off -nostdlib -ffunction-sections -fdata-sections
-    -Wall -Wextra -Werror=double-promotion "-I${TRAX_KERNEL_DIR}")
+    -fstack-size-section -fno-jump-tables -Wall -Wextra -Werror=double-promotion
+    -Werror=implicit-float-conversion -Werror=vla "-I${TRAX_KERNEL_DIR}")
 
 # Compiles one guest source to ${obj}, tracking header dependencies.
 function(_trax_compile obj src)
@@ -164,7 +199,11 @@ function(_trax_compile obj src)
     set(flags ${TRAX_KERNEL_CXX_FLAGS} ${ARGN})
   endif()
   get_filename_component(dir "${obj}" DIRECTORY)
+  # The project's own files by their path in it, tpsim's runtime by its path in tpsim's tree.
   file(RELATIVE_PATH shown "${CMAKE_SOURCE_DIR}" "${src}")
+  if(shown MATCHES "^\\.\\./")
+    file(RELATIVE_PATH shown "${TRAX_KERNEL_DIR}/.." "${src}")
+  endif()
   add_custom_command(
     OUTPUT "${obj}"
     COMMAND "${CMAKE_COMMAND}" -E make_directory "${dir}"
@@ -219,7 +258,10 @@ function(add_trax_kernel NAME)
   add_library(${NAME}_native SHARED ${ARG_SOURCES} "${TRAX_KERNEL_DIR}/runtime/native_twin.cpp")
   target_include_directories(${NAME}_native PRIVATE "${TRAX_KERNEL_DIR}")
   target_compile_features(${NAME}_native PRIVATE cxx_std_20)
-  target_compile_options(${NAME}_native PRIVATE -ffp-contract=off -fno-math-errno)
+  # -g always, so gdb finds the source; the optimisation follows the build type (a folder made
+  # by `tpsim new-kernel` is a Debug build: -O0). Without contraction host float arithmetic is
+  # IEEE single precision at any -O, so the twin stays bit-identical to the ELF either way.
+  target_compile_options(${NAME}_native PRIVATE -g -ffp-contract=off -fno-math-errno)
   set_target_properties(${NAME}_native PROPERTIES
     CXX_VISIBILITY_PRESET hidden
     VISIBILITY_INLINES_HIDDEN ON

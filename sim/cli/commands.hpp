@@ -51,5 +51,6 @@ Command add_render_command(CLI::App& app);
 Command add_compare_command(CLI::App& app);
 Command add_report_command(CLI::App& app);
 Command add_check_command(CLI::App& app);
+Command add_new_kernel_command(CLI::App& app);
 
 }  // namespace tpsim::cli

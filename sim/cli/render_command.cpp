@@ -71,6 +71,7 @@ struct RenderCommandOptions {
     std::string bvh = "sweep";
     uint32_t max_leaf = 8;
     bool native = false;
+    bool no_fork = false;
     std::string timing = "cycle";
     std::string stats_json;
     bool verbose = false;
@@ -110,6 +111,9 @@ int run_render(const RenderCommandOptions& o) {
     options.image_height = o.height;
     options.samples_per_pixel = o.samples_per_pixel;
     options.seed = o.seed;
+    if (o.no_fork && !o.native)
+        throw Error("--no-fork runs the native twin in tpsim's own process: give --native too");
+    options.twin_process = o.no_fork ? render::TwinProcess::in_process : render::TwinProcess::child;
     options.max_instructions = o.max_instructions;
     options.max_item_instructions = o.max_item_instructions;
     options.timeline_interval = o.timeline_cycles;
@@ -254,6 +258,10 @@ Command add_render_command(CLI::App& app) {
         ->capture_default_str();
     command->add_flag("--native", o->native,
                       "Run the kernel's native twin on the host instead of the simulator");
+    command->add_flag("--no-fork", o->no_fork,
+                      "With --native: run the twin in tpsim's own process, for a debugger (gdb "
+                      "--args tpsim render ... --native --no-fork; docs/debugging.md); a crash "
+                      "then stops tpsim");
     command
         ->add_option("--timing", o->timing,
                      "cycle: the cycle-level chip model (cycles, stalls, caches, DRAM); "

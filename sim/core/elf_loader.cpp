@@ -212,6 +212,39 @@ std::vector<Symbol> read_functions(Elf* elf, const std::vector<Segment>& segment
     return functions;
 }
 
+/// Reads .stack_sizes: (4-byte address, ULEB128 size) pairs. A damaged section is read up to
+/// the damage; the bound built on it then misses functions and says so.
+std::vector<Program::FrameSize> read_frame_sizes(Elf* elf) {
+    std::vector<Program::FrameSize> frames;
+    size_t names = 0;
+    if (elf_getshdrstrndx(elf, &names) != 0) return frames;
+    for (Elf_Scn* scn = elf_nextscn(elf, nullptr); scn; scn = elf_nextscn(elf, scn)) {
+        GElf_Shdr sh;
+        const char* section = gelf_getshdr(scn, &sh) ? elf_strptr(elf, names, sh.sh_name) : nullptr;
+        if (!section || std::strcmp(section, ".stack_sizes") != 0 || sh.sh_type == SHT_NOBITS)
+            continue;
+        const Elf_Data* data = elf_getdata(scn, nullptr);
+        if (!data || !data->d_buf) continue;
+        const auto* bytes = static_cast<const uint8_t*>(data->d_buf);
+        for (size_t at = 0; at + 4 < data->d_size;) {
+            uint32_t address = 0;
+            std::memcpy(&address, bytes + at, 4);  // the ELF is little-endian (check_header)
+            at += 4;
+            uint64_t size = 0;
+            int shift = 0;
+            bool done = false;
+            while (at < data->d_size && shift < 35 && !done) {
+                size |= uint64_t(bytes[at] & 0x7f) << shift;
+                done = (bytes[at++] & 0x80) == 0;
+                shift += 7;
+            }
+            if (!done || size > UINT32_MAX) break;
+            frames.push_back({address, uint32_t(size)});
+        }
+    }
+    return frames;
+}
+
 /// A source file as DWARF names it: the file name alone (for messages) and the full path, which
 /// libdw has already joined from DW_AT_comp_dir, the line table's directory and the name;
 /// lexically_normal makes "dir/./x.hpp" and "dir/x.hpp" one file.
@@ -404,6 +437,7 @@ Program load_elf(std::span<const uint8_t> image, const std::string& name) {
                                  program.entry));
     program.functions = read_functions(elf.get(), program.segments);
     read_lines(elf.get(), program);
+    program.frame_sizes = read_frame_sizes(elf.get());
     return program;
 }
 

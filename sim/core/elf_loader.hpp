@@ -58,6 +58,14 @@ public:
     /// The segment holding addr, or nullptr.
     const Segment* segment_at(uint32_t addr) const;
 
+    /// A function's stack frame, from the .stack_sizes section clang writes with
+    /// -fstack-size-section (every kernel has it; stack_bound.hpp uses it).
+    struct FrameSize {
+        uint32_t address;  ///< the function's first instruction
+        uint32_t bytes;    ///< its frame: how far it moves sp down
+    };
+    std::vector<FrameSize> frame_sizes;  ///< in section order; empty without the section
+
     /// Loader-internal: one row of the DWARF line table (sorted by address).
     struct LineRow {
         uint32_t address;

@@ -67,6 +67,19 @@ std::string describe_signal(int signal) {
     }
 }
 
+/// The kernel's output as the twin left it: each thread's bytes one after another. The twin wrote
+/// at most `limit` bytes; a corrupt length cannot read past them.
+trax::KernelOutput collect_output(const char* output, const uint32_t* lengths, uint32_t num_threads,
+                                  uint64_t limit, uint64_t dropped) {
+    std::vector<std::string> threads(num_threads);
+    for (size_t id = 0, at = 0; id < num_threads; ++id) {
+        const size_t length = std::min<size_t>(lengths[id], limit - at);
+        threads[id].assign(output + at, length);
+        at += length;
+    }
+    return trax::KernelOutput::from_parts(std::move(threads), limit, dropped);
+}
+
 }  // namespace
 
 std::filesystem::path native_twin_of(const std::filesystem::path& kernel_elf) {
@@ -75,7 +88,7 @@ std::filesystem::path native_twin_of(const std::filesystem::path& kernel_elf) {
 
 trax::KernelOutput run_native_twin(const std::filesystem::path& library,
                                    std::vector<uint32_t>& global_words, uint32_t num_threads,
-                                   uint32_t num_tms, uint32_t tm_size) {
+                                   uint32_t num_tms, uint32_t tm_size, TwinProcess process) {
     // RTLD_LOCAL keeps each twin's copy of the trax runtime to itself.
     const std::unique_ptr<void, int (*)(void*)> handle(
         dlopen(std::filesystem::absolute(library).c_str(), RTLD_NOW | RTLD_LOCAL), dlclose);
@@ -89,13 +102,37 @@ trax::KernelOutput run_native_twin(const std::filesystem::path& library,
         throw Error(fmt::format("'{}' is not a tpsim native twin (no {} symbol)", library.string(),
                                 TPSIM_NATIVE_RUN_SYMBOL));
 
+    constexpr uint64_t kOutputLimit = trax::KernelOutput::kDefaultLimitBytes;
+    if (process == TwinProcess::in_process) {
+        // Straight on tpsim's memory: a crash is the debugger's to catch, and there is no time
+        // limit, so a thread can stay at a breakpoint for as long as it takes.
+        char error[kErrorBytes] = {};
+        std::vector<char> output(kOutputLimit);
+        std::vector<uint32_t> lengths(num_threads);
+        uint64_t dropped = 0;
+        const TraxNativeContext context{global_words.data(),
+                                        uint32_t(global_words.size()),
+                                        num_threads,
+                                        num_tms,
+                                        tm_size,
+                                        error,
+                                        kErrorBytes,
+                                        output.data(),
+                                        uint32_t(kOutputLimit),
+                                        lengths.data(),
+                                        &dropped};
+        if (run(&context) != 0)
+            throw Error(error[0] != '\0' ? std::string(error)
+                                         : "the native twin failed without saying why");
+        return collect_output(output.data(), lengths.data(), num_threads, kOutputLimit, dropped);
+    }
+
     // The twin is the student's code running on the host: a wild pointer or runaway recursion
     // there is a real SIGSEGV. It runs in a child process over shared memory so that such a
     // crash becomes an error message here instead of killing tpsim.
     // Shared: the error message, the kernel's output (dropped count, lengths, bytes) and the
     // memory image, each aligned for its type.
     const size_t image_bytes = global_words.size() * sizeof(uint32_t);
-    constexpr uint64_t kOutputLimit = trax::KernelOutput::kDefaultLimitBytes;
     const size_t lengths_bytes = size_t(num_threads) * sizeof(uint32_t);
     SharedMapping shared(kErrorBytes + sizeof(uint64_t) + lengths_bytes + image_bytes +
                          kOutputLimit);
@@ -124,20 +161,14 @@ trax::KernelOutput run_native_twin(const std::filesystem::path& library,
     if (WIFSIGNALED(status))
         throw Error(fmt::format(
             "the native twin '{}' stopped: {}; run without --native to have the simulator "
-            "name the thread, pc and source line, or debug the twin with gdb",
+            "name the thread, pc and source line, or run the twin in gdb with --no-fork "
+            "(docs/debugging.md)",
             library.filename().string(), describe_signal(WTERMSIG(status))));
     if (WEXITSTATUS(status) != 0)
         throw Error(error[0] != '\0' ? std::string(error, strnlen(error, kErrorBytes))
                                      : "the native twin failed without saying why");
     std::memcpy(global_words.data(), words, image_bytes);
-    // The twin wrote at most kOutputLimit bytes; a corrupt length cannot read past them.
-    std::vector<std::string> threads(num_threads);
-    for (size_t id = 0, at = 0; id < num_threads; ++id) {
-        const size_t length = std::min<size_t>(lengths[id], kOutputLimit - at);
-        threads[id].assign(output + at, length);
-        at += length;
-    }
-    return trax::KernelOutput::from_parts(std::move(threads), kOutputLimit, *dropped);
+    return collect_output(output, lengths, num_threads, kOutputLimit, *dropped);
 }
 
 }  // namespace tpsim::render

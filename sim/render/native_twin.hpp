@@ -11,11 +11,16 @@ namespace tpsim::render {
 /// The twin library that belongs to a kernel ELF: dir/NAME.elf -> dir/libNAME_native.so.
 std::filesystem::path native_twin_of(const std::filesystem::path& kernel_elf);
 
+/// Where the twin runs: in a child process, so that its crash is an error message (the
+/// default), or in tpsim's own process, so that a debugger sees it (render --no-fork).
+enum class TwinProcess { child, in_process };
+
 /// Loads the twin and runs it over `global_words` (modified in place) with the given thread
 /// shape; returns what the kernel printed. Throws tpsim::Error if the library cannot be loaded
 /// or the kernel reports an error.
 trax::KernelOutput run_native_twin(const std::filesystem::path& library,
                                    std::vector<uint32_t>& global_words, uint32_t num_threads,
-                                   uint32_t num_tms, uint32_t tm_size);
+                                   uint32_t num_tms, uint32_t tm_size,
+                                   TwinProcess process = TwinProcess::child);
 
 }  // namespace tpsim::render

@@ -4,9 +4,11 @@
 #include <cstring>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "sim/core/error.hpp"
 #include "sim/core/machine.hpp"
+#include "sim/core/stack_bound.hpp"
 #include "sim/render/native_twin.hpp"
 #include "sim/render/profile.hpp"
 #include "sim/render/timing_run.hpp"
@@ -69,7 +71,7 @@ uint64_t default_item_instructions(const scene::Scene& scene) {
 
 KernelRun run_kernel(const Kernel& kernel, Engine engine, image::MemoryImage& image,
                      const timing::ChipConfig& chip, uint64_t max_instructions,
-                     uint64_t max_item_instructions) {
+                     uint64_t max_item_instructions, TwinProcess twin_process) {
     switch (engine) {
     case Engine::functional:
         return run_functional(kernel.program, image, chip, max_instructions, max_item_instructions);
@@ -77,7 +79,7 @@ KernelRun run_kernel(const Kernel& kernel, Engine engine, image::MemoryImage& im
         return {{},
                 run_native_twin(native_twin_of(kernel.elf), image.words,
                                 chip.chip.num_tms * chip.chip.tps_per_tm, chip.chip.num_tms,
-                                chip.chip.tps_per_tm)};
+                                chip.chip.tps_per_tm, twin_process)};
     case Engine::timing: {
         TimingRunOptions watch;
         watch.max_instructions = max_instructions;
@@ -87,6 +89,23 @@ KernelRun run_kernel(const Kernel& kernel, Engine engine, image::MemoryImage& im
     }
     }
     return {};
+}
+
+std::string check_stack(const Kernel& kernel, Engine engine, const timing::ChipConfig& chip) {
+    const core::StackBound bound = core::stack_bound(kernel.program);
+    const uint32_t local_store = chip.tp.local_store_bytes;
+    if (bound.bounded && bound.bytes > local_store)
+        throw Error(fmt::format(
+            "stack overflow: kernel '{}' needs up to {} bytes of stack but a thread's local store "
+            "holds {} (tp.local_store_bytes), along {}; make its large local arrays smaller or "
+            "keep them in global memory, or give --set tp.local_store_bytes={}",
+            kernel.elf.filename().string(), bound.bytes, local_store,
+            fmt::join(bound.chain, " -> "), (bound.bytes + 15) / 16 * 16));
+    if (!bound.bounded && engine == Engine::native)
+        return fmt::format("the native twin cannot check the stack against the local store: {}; "
+                           "run without --native to have the simulator check it",
+                           bound.reason);
+    return "";
 }
 
 RenderResult render(const RenderOptions& options) {
@@ -102,6 +121,9 @@ RenderResult render(const RenderOptions& options) {
     result.load_seconds = seconds_since(start);
 
     const Kernel kernel = Kernel::load(options.kernel);
+    if (const std::string warning = check_stack(kernel, options.engine, options.chip);
+        !warning.empty() && options.on_warning)
+        options.on_warning(warning);
     std::optional<scene::Bvh> bvh;
     if (kernel.uses_bvh()) {
         start = std::chrono::steady_clock::now();
@@ -133,7 +155,7 @@ RenderResult render(const RenderOptions& options) {
         result.output = result.timing->machine->output();
     } else {
         KernelRun run = run_kernel(kernel, options.engine, result.image, options.chip,
-                                   options.max_instructions, item_limit);
+                                   options.max_instructions, item_limit, options.twin_process);
         result.instructions = run.instructions;
         result.output = std::move(run.output);
     }

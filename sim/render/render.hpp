@@ -7,6 +7,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -14,6 +15,7 @@
 #include "kernel/kernel_output.hpp"
 #include "sim/core/elf_loader.hpp"
 #include "sim/image/memory_image.hpp"
+#include "sim/render/native_twin.hpp"
 #include "sim/scene/bvh.hpp"
 #include "sim/scene/load_scene.hpp"
 #include "sim/scene/scene.hpp"
@@ -63,6 +65,8 @@ struct RenderOptions {
     scene::UpAxis mesh_up = scene::UpAxis::pos_y;  ///< a bare mesh's up axis, turned to +y
     std::filesystem::path kernel;                  ///< kernel ELF; its twin is found next to it
     Engine engine = Engine::functional;
+    /// Engine::native: in a child process (a crash becomes an error) or in this one (gdb).
+    TwinProcess twin_process = TwinProcess::child;
     /// The BVH to build when the kernel traverses one (its ELF defines the TRAX_USES_BVH
     /// marker); other kernels get no BVH in their memory image. render() sets the depth limit
     /// to the kernels' stack capacity (trax::layout::kTraversalStackEntries).
@@ -132,6 +136,14 @@ uint64_t default_item_instructions(const scene::Scene& scene);
 /// shape: the building block of render() and of tests that bring their own image (ray_query).
 KernelRun run_kernel(const Kernel& kernel, Engine engine, image::MemoryImage& image,
                      const timing::ChipConfig& chip, uint64_t max_instructions = uint64_t(1) << 32,
-                     uint64_t max_item_instructions = 0);
+                     uint64_t max_item_instructions = 0,
+                     TwinProcess twin_process = TwinProcess::child);
+
+/// Throws tpsim::Error when the kernel's deepest call chain (core::stack_bound) needs more stack
+/// than a thread's local store holds: every engine refuses such a kernel before it runs, the
+/// simulator as the twin, whose host stack would not notice. Returns a warning when the stack
+/// cannot be bounded (recursion, calls through pointers) and the engine is the twin, which then
+/// cannot tell an overflow; "" otherwise.
+std::string check_stack(const Kernel& kernel, Engine engine, const timing::ChipConfig& chip);
 
 }  // namespace tpsim::render

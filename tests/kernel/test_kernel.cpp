@@ -178,8 +178,10 @@ TEST_CASE("kernel: kernel ELFs are RV32 executables with only the expected secti
 
     size_t shstrndx = 0;
     REQUIRE(elf_getshdrstrndx(f.elf, &shstrndx) == 0);
-    const std::set<std::string> allowed = {".text",   ".rodata", ".data",     ".bss",
-                                           ".symtab", ".strtab", ".shstrtab", ".riscv.attributes"};
+    // .stack_sizes: every function's frame, for the stack bound (sim/core/stack_bound.hpp).
+    const std::set<std::string> allowed = {".text",     ".rodata",           ".data",
+                                           ".bss",      ".symtab",           ".strtab",
+                                           ".shstrtab", ".riscv.attributes", ".stack_sizes"};
     bool has_text = false;
     for (Elf_Scn* scn = elf_nextscn(f.elf, nullptr); scn; scn = elf_nextscn(f.elf, scn)) {
         GElf_Shdr sh;
