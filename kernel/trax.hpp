@@ -851,14 +851,15 @@ TRAX_INLINE void trax_printi(int value) {
 TRAX_INLINE void trax_printf(float value) {
     trax_printf("%f\n", value);
 }
+// simtrax's printf. The twin sees the C library's printf (the standard headers declare it),
+// which would win over a template for a plain string; there a macro makes printf(...) the
+// kernel's.
 #if defined(__riscv)
 template <class... Args> TRAX_INLINE int printf(const char* format, const Args&... args) {
     trax_printf(format, args...);
     return 0;
 }
 #else
-// The twin sees the C library's printf (the standard headers declare it), which would win over
-// a template for a plain string; the macro makes printf(...) the kernel's in the twin too.
 #define printf(...) (trax_printf(__VA_ARGS__), 0)
 #endif
 /// simtrax's barrier over a global register: tpsim has one barrier for all threads, so the
