@@ -303,7 +303,10 @@ template <TraversalPolicy kPolicy = TraversalPolicy{}> struct BasicBvhTraversal 
 
     static BasicBvhTraversal from_scene() { return {trax_bvh(), trax_triangles()}; }
 
-    template <bool kAnyHit> Hit trace(Vec3 origin, Vec3 dir, float t_max, RayStats& stats) const {
+    // Inlined into its caller: BvhTraversal::trace below is then the tracer's traversal itself.
+    template <bool kAnyHit>
+    [[gnu::always_inline]] inline Hit trace(Vec3 origin, Vec3 dir, float t_max,
+                                            RayStats& stats) const {
         Hit hit;
         hit.t = t_max;
         if (!valid_ray(origin, dir, t_max)) return hit;
@@ -364,7 +367,18 @@ template <TraversalPolicy kPolicy = TraversalPolicy{}> struct BasicBvhTraversal 
         }
     }
 };
-using BvhTraversal = BasicBvhTraversal<>;
+/// The tracer's traversal: BasicBvhTraversal with the defaults, as a class of its own so that
+/// profiles and debuggers name it BvhTraversal::trace.
+struct BvhTraversal {
+    int nodes, triangles;
+
+    static BvhTraversal from_scene() { return {trax_bvh(), trax_triangles()}; }
+
+    template <bool kAnyHit> Hit trace(Vec3 origin, Vec3 dir, float t_max, RayStats& stats) const {
+        return BasicBvhTraversal<>{nodes, triangles}.template trace<kAnyHit>(origin, dir, t_max,
+                                                                             stats);
+    }
+};
 
 /// A closest hit's surface point p = origin + t*dir and a bound on its distance from the
 /// triangle's plane. The offset below follows pbrt-v4 (Pharr, Jakob and Humphreys, "Physically
@@ -456,6 +470,7 @@ enum class PixelOrder { scanlines, tiles, morton };
 struct RenderPolicy {
     PixelOrder order = PixelOrder::scanlines;
     bool any_hit_shadows = true;
+    bool operator==(const RenderPolicy&) const = default;
 };
 
 /// Work items to hand out for a width x height image in `order`.
@@ -493,19 +508,27 @@ inline int pixel_of(int item, int width, int height, PixelOrder order) {
     return x < width && y < height ? y * width + x : -1;
 }
 
-/// The shadow ray from surface point s to `target` (a light), from the origin offset towards
-/// the target: any hit on the segment, or the closest when kAnyHit is false.
-template <class Accel, bool kAnyHit = true>
-Hit trace_to(const Accel& accel, const SurfacePoint& s, Vec3 target, RayStats& stats) {
+/// The ray from surface point s to `target` (a light), from the origin offset towards the
+/// target: any hit on the segment, or the closest when kAnyHit is false.
+template <bool kAnyHit, class Accel>
+[[gnu::always_inline]] inline Hit trace_segment(const Accel& accel, const SurfacePoint& s,
+                                                Vec3 target, RayStats& stats) {
     const Vec3 start = offset_origin(s, target - s.p);
     return accel.template trace<kAnyHit>(start, target - start, 1.0f, stats);
 }
 
+/// The shadow ray from surface point s to `target`: any hit on the segment.
+template <class Accel>
+Hit trace_to(const Accel& accel, const SurfacePoint& s, Vec3 target, RayStats& stats) {
+    return trace_segment<true>(accel, s, target, stats);
+}
+
 /// Lambert shading of the camera ray (origin, dir): ambient plus every point light facing the
 /// surface, with hard shadows (any-hit rays from the offset hit point) and 1/d^2 falloff when
-/// the scene asks for them.
-template <RenderPolicy kPolicy = RenderPolicy{}, class Accel>
-Vec3 shade(const Shading& s, const Accel& accel, Vec3 origin, Vec3 dir, ThreadTotals& totals) {
+/// the scene asks for them. shade() below is this with the default policy.
+template <RenderPolicy kPolicy, class Accel>
+[[gnu::always_inline]] inline Vec3 shade_with(const Shading& s, const Accel& accel, Vec3 origin,
+                                              Vec3 dir, ThreadTotals& totals) {
     RayStats primary;
     const Hit hit = accel.template trace<false>(origin, dir, 3.0e38f, primary);
     totals.add(primary, false);
@@ -529,14 +552,20 @@ Vec3 shade(const Shading& s, const Accel& accel, Vec3 origin, Vec3 dir, ThreadTo
         if (s.flags & kFeatureLightFalloff) weight = weight / distance2;
         if (s.flags & kFeatureShadows) {
             RayStats shadow;
-            const Hit blocker =
-                trace_to<Accel, kPolicy.any_hit_shadows>(accel, surface, light_position, shadow);
+            const Hit blocker = kPolicy.any_hit_shadows
+                                    ? trace_to(accel, surface, light_position, shadow)
+                                    : trace_segment<false>(accel, surface, light_position, shadow);
             totals.add(shadow, true);
             if (blocker.triangle >= 0) continue;
         }
         light_sum = light_sum + load_vec3(light, kLightColor) * weight;
     }
     return albedo * light_sum;
+}
+
+template <class Accel>
+Vec3 shade(const Shading& s, const Accel& accel, Vec3 origin, Vec3 dir, ThreadTotals& totals) {
+    return shade_with<RenderPolicy{}>(s, accel, origin, dir, totals);
 }
 
 /// Integer hash (Wellons' "lowbias32"): decorrelated jitter that depends only on its input.
@@ -556,9 +585,9 @@ inline float unit_float(uint32_t bits) {
 /// The whole render kernel: pixels handed out with atomicinc(0) in the policy's order; each gets
 /// samples_per_pixel camera rays (pixel centre for one sample, hashed jitter for more), shaded
 /// and averaged into the framebuffer as linear RGB; the thread's statistics record is written
-/// at the end.
-template <RenderPolicy kPolicy = RenderPolicy{}, class Accel>
-void render_image(const Accel& accel) {
+/// at the end. render_image() below is this with the default policy.
+template <RenderPolicy kPolicy, class Accel>
+[[gnu::always_inline]] inline void render_image_with(const Accel& accel) {
     const Shading s = Shading::from_scene();
     const int width = trax_image_width(), height = trax_image_height();
     const int samples = trax_samples_per_pixel();
@@ -586,7 +615,10 @@ void render_image(const Accel& accel) {
                 jy = unit_float(hash(key + 1u));
             }
             const Vec3 dir = corner + right * ((x + jx) / fwidth) + down * ((y + jy) / fheight);
-            color = color + shade<kPolicy>(s, accel, eye, dir, totals);
+            if constexpr (kPolicy == RenderPolicy{})
+                color = color + shade(s, accel, eye, dir, totals);
+            else
+                color = color + shade_with<kPolicy>(s, accel, eye, dir, totals);
         }
         color = color * (1.0f / static_cast<float>(samples));
         const int out = framebuffer + pixel * kPixelWords;
@@ -595,6 +627,10 @@ void render_image(const Accel& accel) {
         storef(color.z, out, 2);
     }
     totals.store();
+}
+
+template <class Accel> void render_image(const Accel& accel) {
+    render_image_with<RenderPolicy{}>(accel);
 }
 
 }  // namespace trax::rt

@@ -6,5 +6,5 @@ TRAX_USES_BVH;
 
 void trax_main() {
     using namespace trax::rt;
-    render_image<RenderPolicy{.any_hit_shadows = false}>(BvhTraversal::from_scene());
+    render_image_with<RenderPolicy{.any_hit_shadows = false}>(BvhTraversal::from_scene());
 }

@@ -6,5 +6,5 @@ TRAX_USES_BVH;
 
 void trax_main() {
     using namespace trax::rt;
-    render_image<RenderPolicy{.order = PixelOrder::morton}>(BvhTraversal::from_scene());
+    render_image_with<RenderPolicy{.order = PixelOrder::morton}>(BvhTraversal::from_scene());
 }
