@@ -207,6 +207,79 @@ private:
     count();
 }
 
+template <class Observe>
+[[gnu::flatten]] inline bool Machine::run_observed(uint32_t id, uint64_t budget, uint64_t& executed,
+                                                   StepRecord& last, Observe&& observe) {
+    executed = 0;
+    if (id >= config_.threads) [[unlikely]]
+        refuse_step(id);
+    Thread& t = threads_[id];
+    if (t.state != ThreadState::Running) [[unlikely]]
+        refuse_step(id);
+    isa::Hart& h = t.hart;
+    StepRecord record;
+    ThreadEnv<true> env(*this, id, &record);
+    uint64_t* per_op = counters_.per_op.data();
+    const isa::Decoded* decoded = decoded_.data() + entry_code_.first;
+    uint32_t text_base = entry_code_.base;
+    uint32_t text_words = entry_code_.words;
+    uint64_t n = 0;
+    bool stopped = false;
+    uint32_t pc = h.pc;
+    const auto count = [&] {
+        executed = n;
+        t.executed += n;
+        counters_.instructions += n;
+    };
+    const uint64_t left = instructions_left(t);
+    if (left == 0) [[unlikely]]
+        limit_fault(id);
+    try {
+        // Up to the limits as they stand now (a new work item raises the item limit; the next
+        // call sees it).
+        for (const uint64_t end = std::min(budget, left); n < end;) {
+            pc = h.pc;
+            uint32_t index = std::rotr(pc - text_base, 2);
+            if (index >= text_words) [[unlikely]] {
+                const CodeRange* range = code_range_at(pc);
+                if (!range) fetch_fault(id, pc);
+                decoded = decoded_.data() + range->first;
+                text_base = range->base;
+                text_words = range->words;
+                index = (pc - text_base) / 4;
+            }
+            const isa::Decoded& d = decoded[index];
+            ++per_op[size_t(d.op)];
+            record = StepRecord{.pc = pc, .insn = &d};
+            isa::execute<ThreadEnv<true>, false>(d, h, env);
+            ++n;
+            if (record.exited || d.fu == isa::FuClass::Sync) [[unlikely]] {
+                record.taken = !record.exited && h.pc != pc + 4;
+                last = record;
+                stopped = true;
+                break;
+            }
+            if (record.mem_bytes != 0 || d.fu == isa::FuClass::Atomic) observe(record);
+        }
+    } catch (const ThreadSuspended&) {
+        ++n;  // a synchronisation instruction completed; the thread waits
+        record.taken = false;
+        last = record;
+        stopped = true;
+    } catch (const GuestFault& f) {
+        if (!take_trap(h, f)) {
+            count();
+            fault(id, pc, f);
+        }
+        ++n;  // the access did not happen; the trap handler runs next
+    } catch (...) {
+        count();
+        throw;
+    }
+    count();
+    return stopped;
+}
+
 inline bool Machine::is_private(const isa::Hart& h, uint32_t index, uint32_t words,
                                 uint32_t first) const {
     if (index >= words) return false;

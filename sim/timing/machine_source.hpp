@@ -72,6 +72,37 @@ public:
         next_pc_[thread] = a.next < a.size ? a.records[a.next].pc : machine_.next_pc(thread);
     }
 
+    /// Functional warming (Chip::warm): thread `thread` executes up to `budget` instructions,
+    /// first those it has run ahead, calling observe(record) for each that accesses memory or
+    /// is an atomic increment; stops after an exit or a synchronisation instruction, leaving
+    /// its record in `last` (and returns true). `executed` counts the instructions.
+    template <class Observe>
+    bool warm(uint32_t thread, uint64_t budget, uint64_t& executed, StepInfo& last,
+              Observe&& observe) {
+        Ahead& a = ahead_[thread];
+        executed = 0;
+        for (; a.next < a.size && executed < budget; ++executed) {
+            const StepInfo& s = a.records[a.next++];
+            if (s.exited || s.insn->fu == isa::FuClass::Sync) {
+                last = s;
+                ++executed;
+                next_pc_[thread] =
+                    a.next < a.size ? a.records[a.next].pc : machine_.next_pc(thread);
+                return true;
+            }
+            if (s.mem_bytes != 0 || s.insn->fu == isa::FuClass::Atomic) observe(s);
+        }
+        bool stopped = false;
+        if (executed < budget) {
+            if (a.fault) std::rethrow_exception(std::exchange(a.fault, nullptr));
+            uint64_t more = 0;
+            stopped = machine_.run_observed(thread, budget - executed, more, last, observe);
+            executed += more;
+        }
+        next_pc_[thread] = a.next < a.size ? a.records[a.next].pc : machine_.next_pc(thread);
+        return stopped;
+    }
+
 private:
     static constexpr uint32_t kAhead = 128;  // records buffered per thread
     struct Ahead {
