@@ -107,6 +107,7 @@ public:
 
 private:
     struct Tm;
+    struct WarmingObserver;
     // The cycle loop is instantiated for the concrete MachineSource (its calls inline) and for
     // any other InstructionSource (tests' scripted sources); the constructor picks one.
     template <class Source> bool run_cycles(uint64_t end);
