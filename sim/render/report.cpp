@@ -352,6 +352,8 @@ nlohmann::ordered_json stats_document(const RenderOptions& options, const Render
     run["kernel"] = options.kernel.generic_string();
     run["kernel_name"] = options.kernel.stem().string();
     run["engine"] = engine_name(options.engine);
+    // How the cycle-level engine ran: every cycle, or sampled (its figures are estimates).
+    if (r.timing) run["timing"] = r.timing->sampling ? "sampled" : "cycle";
     run["bvh_builder"] = scene::to_string(options.bvh.builder);
     run["max_leaf"] = options.bvh.max_leaf_size;
     run["width"] = r.scene.width;

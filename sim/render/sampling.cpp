@@ -108,7 +108,8 @@ stats::UnitSamples run_sampled(timing::Chip& chip, const stats::Registry& chip_s
     summary.tail_instructions = done(end) - tail_done;
     summary.warmed_instructions = chip.warmed_instructions();
     summary.simulated_cycles = chip.cycles();
-    summary.exact = summary.units == 0;
+    // Measured whole only if nothing was left to estimate (the head reached the tail).
+    summary.exact = summary.body_instructions == 0;
     samples.body_instructions = double(summary.body_instructions);
     for (size_t k = 0; k < sampled.size(); ++k) {
         const size_t i = sampled[k];

@@ -39,13 +39,14 @@ struct SamplingSummary {
     uint64_t tail_instructions = 0;    ///< measured whole, to the end
     uint64_t warmed_instructions = 0;  ///< executed under functional warming
     uint64_t simulated_cycles = 0;     ///< cycles the cycle-level model ran, drains included
-    bool exact =
-        false;  ///< the run ended within its head: every figure is measured, none estimated
+    /// The head reached the tail: every figure is measured, none estimated.
+    bool exact = false;
 };
 
 /// Runs the chip (fresh, over a machine source) to its end, sampled. `chip_stats` holds the
 /// chip's statistics (Chip::register_stats); `progress` is called now and then. Returns the
-/// units and the exactly measured remainder for stats::estimate (no units: summary.exact).
+/// units and the exactly measured remainder for stats::estimate (nothing to estimate:
+/// summary.exact).
 stats::UnitSamples run_sampled(timing::Chip& chip, const stats::Registry& chip_stats,
                                const SamplingOptions& options, SamplingSummary& summary,
                                const std::function<void()>& progress);
