@@ -194,11 +194,55 @@ void cards(Page& page, const StatsFile& run) {
                          {"traversal/triangles_per_ray", "triangles per ray", 1, ""}};
     page.body << "<section class=\"cards\">\n";
     for (const Card& card : list)
-        if (const auto value = run.stat(card.key))
-            page.body << fmt::format("<div class=\"card\"><div class=\"value\">{}{}</div>"
+        if (const auto value = run.stat(card.key)) {
+            // An estimate carries its interval, relative to it.
+            const double half = run.interval(card.key);
+            const std::string interval =
+                half != 0 && *value != 0
+                    ? fmt::format(" <span class=\"interval\">&plusmn; {:.2g} %</span>",
+                                  100 * half / std::abs(*value))
+                    : "";
+            page.body << fmt::format("<div class=\"card\"><div class=\"value\">{}{}{}</div>"
                                      "<div class=\"label\">{}</div></div>\n",
-                                     short_number(*value * card.scale), card.suffix, card.label);
+                                     run.estimated() ? "~" : "", short_number(*value * card.scale),
+                                     card.suffix + interval, card.label);
+        }
     page.body << "</section>\n";
+}
+
+/// What a sampled run's figures are: estimates, how they were made, and the key ones with
+/// their intervals.
+void sampling(Page& page, const StatsFile& run) {
+    if (!run.sampling) return;
+    const Json& s = *run.sampling;
+    const auto number = [&](const char* key) { return s.value(key, 0.0); };
+    if (!run.estimated()) {
+        page.body << "<p class=\"note\">Sampled simulation: the run ended within its first "
+                     "unit, so every figure was measured cycle by cycle.</p>\n";
+        return;
+    }
+    page.body << fmt::format(
+        "<h2>Estimates (sampled simulation)</h2>\n<p class=\"note\"><b>The cycle-level figures "
+        "of this report are estimates</b> with {:.0f} % confidence intervals: {} units of {} "
+        "cycles (after {} cycles of warm-up each) at a rate of {}, seed {}; the rest of the run "
+        "executed under functional warming (docs/error-vs-time.md).</p>\n",
+        100 * number("confidence"), readable(number("units")), readable(number("unit_cycles")),
+        readable(number("warmup_cycles")), number("rate"), readable(number("seed")));
+    page.body << "<table><tr><th>statistic</th><th class=\"num\">estimate</th>"
+                 "<th class=\"num\">&plusmn; 95 %</th><th class=\"num\">relative</th></tr>\n";
+    for (const char* key :
+         {"chip/cycles", "chip/issue_rate", "chip/l1/hit_rate", "chip/l2/hit_rate",
+          "dram/bytes_read", "dram/bytes_written", "chip/stalls/operand", "chip/stalls/fu_busy",
+          "chip/stalls/fetch_conflict", "chip/stalls/memory_port", "chip/stalls/branch"})
+        if (const auto value = run.stat(key)) {
+            const double half = run.interval(key);
+            page.body << fmt::format(
+                "<tr><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
+                "<td class=\"num\">{}</td></tr>\n",
+                key, readable(*value), readable(half),
+                *value != 0 ? fmt::format("{:.2f} %", 100 * half / std::abs(*value)) : "");
+        }
+    page.body << "</table>\n";
 }
 
 /// Region names and the levels each has, from "region/<r>/<level>/<leaf>" keys (table order
@@ -520,6 +564,7 @@ std::string report_page(const StatsFile& run, const std::string& chart_js) {
                              escape(scene.empty() ? run.path.filename().string() : scene),
                              run_line(run), escape(run.path.string()));
     cards(page, run);
+    sampling(page, run);
     const auto image = run.run_file("image");
     const auto heatmap = run.run_file("heatmap");
     if (image || heatmap) {

@@ -148,6 +148,11 @@ std::optional<double> StatsFile::stat(std::string_view name) const {
     return stats[found->second].second;
 }
 
+double StatsFile::interval(std::string_view name) const {
+    const auto found = intervals.find(name);
+    return found == intervals.end() ? 0.0 : found->second;
+}
+
 std::string StatsFile::unit(std::string_view name) const {
     const auto found = units.find(name);
     return found == units.end() ? std::string() : found->second;
@@ -234,6 +239,10 @@ StatsFile parse_stats_file(std::string_view text, const std::filesystem::path& p
             f.regions.push_back(r.string(region, "\"regions\"[]"));
     if (document.contains("timeline")) f.timeline = read_timeline(r, document["timeline"]);
     if (document.contains("profile")) f.profile = read_profile(r, document["profile"]);
+    if (document.contains("sampling")) f.sampling = r.object(document["sampling"], "\"sampling\"");
+    if (document.contains("intervals"))
+        for (const auto& [name, half] : r.object(document["intervals"], "\"intervals\"").items())
+            f.intervals.emplace(name, r.number(half, "\"intervals\"." + in_quotes(name)));
     return f;
 }
 

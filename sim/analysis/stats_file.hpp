@@ -57,8 +57,16 @@ struct StatsFile {
     std::vector<std::string> regions;  ///< empty unless the cycle-level engine ran
     std::optional<Timeline> timeline;
     std::optional<Profile> profile;
+    /// A sampled run (render --timing sampled): what was sampled, and the half-width of each
+    /// estimate's confidence interval (statistics absent here are exact).
+    std::optional<Json> sampling;
+    std::map<std::string, double, std::less<>> intervals;
 
     std::optional<double> stat(std::string_view name) const;
+    /// The half-width of the estimate's interval; 0 for an exact value.
+    double interval(std::string_view name) const;
+    /// Are the statistics estimates (a sampled run)?
+    bool estimated() const { return sampling && sampling->value("estimated", false); }
     std::string unit(std::string_view name) const;
     /// A run field as text ("" when absent): strings as they are, numbers printed.
     std::string run_text(std::string_view key) const;

@@ -73,6 +73,8 @@ struct RenderCommandOptions {
     bool native = false;
     bool no_fork = false;
     std::string timing = "cycle";
+    render::SamplingOptions sampling;
+    bool sampling_set = false;  // a --sample-* option was given
     std::string stats_json;
     bool verbose = false;
     uint64_t timeline_cycles = 0;
@@ -87,7 +89,7 @@ struct RenderCommandOptions {
     uint32_t width = 0, height = 0, samples_per_pixel = 0, seed = 0;  // 0 size/spp: the scene's
 };
 
-int run_render(const RenderCommandOptions& o) {
+int run_render(RenderCommandOptions& o) {
     render::RenderOptions options;
     options.scene = o.scene;
     if (!o.up.empty()) {
@@ -104,9 +106,16 @@ int run_render(const RenderCommandOptions& o) {
         fmt::print(stderr, "tpsim: warning: {}\n", warning);
     };
     options.kernel = resolve_kernel(o.kernel);
-    options.engine = o.native              ? render::Engine::native
-                     : o.timing == "cycle" ? render::Engine::timing
-                                           : render::Engine::functional;
+    options.engine = o.native             ? render::Engine::native
+                     : o.timing != "none" ? render::Engine::timing
+                                          : render::Engine::functional;
+    if (o.sampling_set && (o.timing != "sampled" || o.native))
+        throw Error("--sample-rate, --sample-unit, --sample-warmup and --sample-seed set up "
+                    "sampled simulation: give --timing sampled too");
+    if (o.timing == "sampled" && !o.native) {
+        o.sampling.validate();
+        options.sampling = o.sampling;
+    }
     options.image_width = o.width;
     options.image_height = o.height;
     options.samples_per_pixel = o.samples_per_pixel;
@@ -147,6 +156,10 @@ int run_render(const RenderCommandOptions& o) {
                                     "none",
                                     needs));
     }
+    if (options.sampling && (options.profile || !o.heatmap.empty()))
+        throw Error(
+            fmt::format("{} every cycle simulated: use --timing cycle, not sampled",
+                        options.profile ? "--profile and --annotate need" : "--heatmap needs"));
 
     ProgressLine progress_line;
     options.on_progress = [&](const render::Progress& p) { progress_line.update(p); };
@@ -154,11 +167,10 @@ int run_render(const RenderCommandOptions& o) {
     progress_line.clear();
     render::write_image(output, result.rgb, result.scene.width, result.scene.height);
 
-    render::print_summary(options, result, std::cout);
+    const render::RunStatistics statistics = render::run_statistics(result);
+    const stats::Snapshot& snapshot = statistics.values;
+    render::print_summary(options, result, statistics, std::cout);
     fmt::print("image    {}\n", output.string());
-    stats::Registry registry;
-    render::register_stats(result, registry);
-    const stats::Snapshot snapshot(registry);
     render::print_traffic(snapshot, options.chip.l2.line_bytes, std::cout);
     print_kernel_output(result.output);
     if (result.profile) {
@@ -186,10 +198,10 @@ int run_render(const RenderCommandOptions& o) {
     const render::OutputPaths outputs{output, o.heatmap};
     if (!o.stats_json.empty()) {
         const std::filesystem::path json_path = o.stats_json;
-        write_output(json_path,
-                     render::stats_document(options, result, snapshot, json_path, outputs).dump(1) +
-                         '\n',
-                     "statistics");
+        write_output(
+            json_path,
+            render::stats_document(options, result, statistics, json_path, outputs).dump(1) + '\n',
+            "statistics");
         // The configuration as a file the user can pass back with -c.
         const std::filesystem::path config_path =
             std::filesystem::path(o.stats_json).replace_extension(".config.toml");
@@ -198,7 +210,7 @@ int run_render(const RenderCommandOptions& o) {
     if (!o.html.empty()) {
         // The page is made from the statistics file, as `tpsim report` makes it.
         const std::string document =
-            render::stats_document(options, result, snapshot, o.html, outputs).dump();
+            render::stats_document(options, result, statistics, o.html, outputs).dump();
         write_output(o.html,
                      analysis::report_page(analysis::parse_stats_file(document, o.html), chart_js),
                      "the report");
@@ -265,9 +277,36 @@ Command add_render_command(CLI::App& app) {
     command
         ->add_option("--timing", o->timing,
                      "cycle: the cycle-level chip model (cycles, stalls, caches, DRAM); "
-                     "none: the functional simulator only (fast, same image)")
-        ->check(CLI::IsMember({"cycle", "none"}))
+                     "sampled: the chip model on a sample of the run, the rest functionally "
+                     "warmed; estimates with 95 % intervals, same image "
+                     "(docs/error-vs-time.md); none: the functional simulator only (fast, "
+                     "same image)")
+        ->check(CLI::IsMember({"cycle", "sampled", "none"}))
         ->capture_default_str();
+    const auto sampling_option = [&](std::string_view name, auto& field, std::string help) {
+        return command
+            ->add_option_function<std::remove_reference_t<decltype(field)>>(
+                std::string(name),
+                [o, &field](const auto& value) {
+                    field = value;
+                    o->sampling_set = true;
+                },
+                std::move(help))
+            ->default_str(fmt::format("{}", field));
+    };
+    sampling_option("--sample-rate", o->sampling.rate,
+                    "--timing sampled: share of the instructions simulated cycle by cycle "
+                    "(warm-up, unit, drain), in (0, 1]")
+        ->check(CLI::Range(0.0, 1.0));
+    sampling_option("--sample-unit", o->sampling.unit_cycles,
+                    "--timing sampled: cycles measured per unit")
+        ->check(kPositiveCount);
+    sampling_option("--sample-warmup", o->sampling.warmup_cycles,
+                    "--timing sampled: cycle-level warm-up before each unit, not measured")
+        ->check(kWholeNumber);
+    sampling_option("--sample-seed", o->sampling.seed,
+                    "--timing sampled: picks the sample's random start")
+        ->check(whole_number_in(0, UINT32_MAX));
     command->add_option("--stats-json", o->stats_json,
                         "Also write the statistics file (JSON, read by tpsim compare and tpsim "
                         "report) here, and the chip configuration beside it (PATH with "

@@ -103,6 +103,15 @@ public:
     /// instruction faults, the Fault is thrown with `done` counting the records written before
     /// it. Defined in thread_env.hpp so the cycle loop can inline it.
     inline void run_ahead(uint32_t id, StepRecord* out, uint32_t capacity, uint32_t& done);
+    /// Functional warming's step (timing::Chip::warm): executes up to `budget` instructions of
+    /// thread `id` (never past the instruction limits) without records; `observer` hears of
+    /// every load, store and atomic increment as ThreadEnv describes. Stops after an exit or
+    /// a synchronisation instruction, whose record it leaves in `last`, and returns true then.
+    /// `executed` counts the instructions run. Throws Fault as run_ahead() does. Defined in
+    /// thread_env.hpp.
+    template <class Observer>
+    inline bool run_observed(uint32_t id, uint64_t budget, uint64_t& executed, StepRecord& last,
+                             Observer& observer);
 
     /// Timing mode: the cycle/time CSRs read `*cycles` (the chip's current cycle) instead of
     /// instret; nullptr (the default) = functional mode, where cycle = instret. The counter
@@ -132,7 +141,7 @@ public:
     const trax::KernelOutput& output() const { return output_; }
 
 private:
-    template <bool kRecord> friend class ThreadEnv;
+    template <bool kRecord, class Observer> friend class ThreadEnv;
 
     void run_quantum(uint32_t id, uint64_t budget);
     /// The code range holding the aligned pc, or nullptr (a fetch fault). Cold: the run loops

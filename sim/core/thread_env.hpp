@@ -20,25 +20,34 @@ constexpr unsigned kA0 = 10, kA7 = 17, kSp = 2;
 
 struct NoRecorder {};
 
+/// A ThreadEnv without an observer (Machine::run_observed's has one).
+struct NoObserver {};
+
 }  // namespace detail
 
 /// The isa::execute environment of one thread. kRecord adds the bookkeeping step() reports,
-/// written straight into its record; the fast path instantiates it away.
-template <bool kRecord> class ThreadEnv {
+/// written straight into its record; the fast path instantiates it away. An Observer (not
+/// detail::NoObserver) hears of every load and store (observer.access(addr, bytes, store))
+/// and atomic increment (observer.atomic(global_register, old)) as it happens.
+template <bool kRecord, class Observer = detail::NoObserver> class ThreadEnv {
 public:
     using Record = std::conditional_t<kRecord, StepRecord*, detail::NoRecorder>;
+    static constexpr bool kObserved = !std::is_same_v<Observer, detail::NoObserver>;
+    using ObserverRef = std::conditional_t<kObserved, Observer*, detail::NoObserver>;
 
-    ThreadEnv(Machine& machine, uint32_t id, Record record = {})
+    ThreadEnv(Machine& machine, uint32_t id, Record record = {}, ObserverRef observer = {})
         : machine_(machine), thread_(machine.threads_[id]), id_(id),
-          local_(machine.memory_.local_store(id).data()), record_(record) {}
+          local_(machine.memory_.local_store(id).data()), record_(record), observer_(observer) {}
 
     template <class T> T load(uint32_t addr) {
         if constexpr (kRecord) record_access(addr, sizeof(T), false);
+        if constexpr (kObserved) observer_->access(addr, sizeof(T), false);
         return machine_.memory_.load<T>(addr, local_);
     }
 
     template <class T> void store(uint32_t addr, T value) {
         if constexpr (kRecord) record_access(addr, sizeof(T), true);
+        if constexpr (kObserved) observer_->access(addr, sizeof(T), true);
         machine_.memory_.store<T>(addr, value, local_);
     }
 
@@ -49,6 +58,7 @@ public:
         // Register 0 hands out the work items (pixels): a new item starts.
         if (global_register == 0) thread_.item_start = thread_.hart.instret;
         if constexpr (kRecord) record_->atomic_result = old;
+        if constexpr (kObserved) observer_->atomic(global_register, old);
         return old;
     }
 
@@ -128,6 +138,7 @@ private:
     uint32_t id_;
     uint8_t* local_;
     [[no_unique_address]] Record record_;
+    [[no_unique_address]] ObserverRef observer_;
 };
 
 // The timing model's hot path: the functional core's stretch of one thread (see
@@ -205,6 +216,82 @@ private:
         throw;
     }
     count();
+}
+
+template <class Observer>
+[[gnu::flatten]] inline bool Machine::run_observed(uint32_t id, uint64_t budget, uint64_t& executed,
+                                                   StepRecord& last, Observer& observer) {
+    executed = 0;
+    if (id >= config_.threads) [[unlikely]]
+        refuse_step(id);
+    Thread& t = threads_[id];
+    if (t.state != ThreadState::Running) [[unlikely]]
+        refuse_step(id);
+    const uint64_t left = instructions_left(t);
+    if (left == 0) [[unlikely]]
+        limit_fault(id);
+    isa::Hart& h = t.hart;
+    ThreadEnv<false, Observer> env(*this, id, {}, &observer);
+    uint64_t* per_op = counters_.per_op.data();
+    const isa::Decoded* decoded = decoded_.data() + entry_code_.first;
+    uint32_t text_base = entry_code_.base;
+    uint32_t text_words = entry_code_.words;
+    uint64_t n = 0;
+    bool stopped = false;
+    uint32_t pc = h.pc;
+    try {
+        // Up to the limits as they stand now (a new work item raises the item limit; the next
+        // call sees it).
+        for (const uint64_t end = std::min(budget, left); n < end; ++n) {
+            pc = h.pc;
+            uint32_t index = std::rotr(pc - text_base, 2);
+            if (index >= text_words) [[unlikely]] {
+                const CodeRange* range = code_range_at(pc);
+                if (!range) fetch_fault(id, pc);
+                decoded = decoded_.data() + range->first;
+                text_base = range->base;
+                text_words = range->words;
+                index = (pc - text_base) / 4;
+            }
+            const isa::Decoded& d = decoded[index];
+            ++per_op[size_t(d.op)];
+            if (d.fu == isa::FuClass::Sync || d.fu == isa::FuClass::System) [[unlikely]] {
+                // What the chip needs of an exit or a synchronisation is in its record.
+                ThreadEnv<true, Observer> recording(*this, id, &last, &observer);
+                last = StepRecord{.pc = pc, .insn = &d};
+                isa::execute<ThreadEnv<true, Observer>, false>(d, h, recording);
+                last.taken = !last.exited && h.pc != pc + 4;
+                if (last.exited || d.fu == isa::FuClass::Sync) {
+                    ++n;
+                    stopped = true;
+                    break;
+                }
+                continue;
+            }
+            isa::execute<ThreadEnv<false, Observer>, false>(d, h, env);
+        }
+    } catch (const ThreadSuspended&) {
+        ++n;  // a synchronisation instruction completed; the thread waits
+        last.taken = false;
+        stopped = true;
+    } catch (const GuestFault& f) {
+        if (!take_trap(h, f)) {
+            executed = n;
+            t.executed += n;
+            counters_.instructions += n;
+            fault(id, pc, f);
+        }
+        ++n;  // the access did not happen; the trap handler runs next
+    } catch (...) {
+        executed = n;
+        t.executed += n;
+        counters_.instructions += n;
+        throw;
+    }
+    executed = n;
+    t.executed += n;
+    counters_.instructions += n;
+    return stopped;
 }
 
 inline bool Machine::is_private(const isa::Hart& h, uint32_t index, uint32_t words,

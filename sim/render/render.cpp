@@ -147,7 +147,7 @@ RenderResult render(const RenderOptions& options) {
             run_timing(kernel.program, result.image, options.chip,
                        {options.max_instructions, item_limit,
                         uint64_t(result.scene.width) * result.scene.height, options.on_progress,
-                        options.timeline_interval, options.profile});
+                        options.timeline_interval, options.profile, options.sampling});
         if (options.profile)
             result.profile = std::make_shared<const Profile>(
                 profile_of(result.timing->chip->profile(), kernel.program));

@@ -16,6 +16,7 @@
 #include "sim/core/elf_loader.hpp"
 #include "sim/image/memory_image.hpp"
 #include "sim/render/native_twin.hpp"
+#include "sim/render/sampling.hpp"
 #include "sim/scene/bvh.hpp"
 #include "sim/scene/load_scene.hpp"
 #include "sim/scene/scene.hpp"
@@ -87,6 +88,8 @@ struct RenderOptions {
     std::function<void(const std::string&)> on_warning;
     uint64_t timeline_interval = 0;  ///< Engine::timing: cycles per timeline row, 0 = adapt
     bool profile = false;  ///< Engine::timing: collect the source-line profile (RenderResult)
+    /// Engine::timing: sampled simulation (sampling.hpp) instead of every cycle.
+    std::optional<SamplingOptions> sampling;
 };
 
 /// Instruction counts of a simulated run.

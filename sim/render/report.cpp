@@ -1,5 +1,7 @@
 #include "sim/render/report.hpp"
 
+#include <cmath>
+
 #include <algorithm>
 #include <ostream>
 
@@ -185,12 +187,9 @@ void register_stats(const RenderResult& r, stats::Registry& reg) {
     if (r.timing) {
         r.timing->chip->register_stats(reg);
         if (reg.contains("rays/total"))
-            reg.add_derived(
-                "chip/rays_per_second",
-                [&reg] {
-                    const double seconds = reg.value("chip/frame_seconds");
-                    return seconds > 0 ? reg.value("rays/total") / seconds : 0.0;
-                },
+            reg.add_formula(
+                "chip/rays_per_second", {"rays/total", "chip/frame_seconds"},
+                [](std::span<const double> v) { return v[1] > 0 ? v[0] / v[1] : 0.0; },
                 "rays traced per simulated second (rays/total / chip/frame_seconds)", "rays/s");
     }
     number(
@@ -204,7 +203,59 @@ void register_stats(const RenderResult& r, stats::Registry& reg) {
             "simulation speed", "instr/s");
 }
 
-void print_summary(const RenderOptions& options, const RenderResult& r, std::ostream& out) {
+RunStatistics run_statistics(const RenderResult& result) {
+    RunStatistics statistics;
+    register_stats(result, statistics.registry);
+    statistics.values = stats::Snapshot(statistics.registry);
+    if (result.timing && result.timing->sampling && !result.timing->sampling->exact) {
+        statistics.estimate =
+            stats::estimate(statistics.registry, statistics.values, result.timing->samples);
+        statistics.values = statistics.estimate->values;
+    }
+    return statistics;
+}
+
+namespace {
+
+/// "1234567 ± 0.8 %": an estimate with its interval relative to it.
+std::string with_interval(const stats::Estimate& e, std::string_view name, std::string value) {
+    const double estimate = e.values.value(name);
+    const double half = e.interval(name);
+    return estimate != 0 ? fmt::format("{} ± {:.2f} %", value, 100 * half / std::abs(estimate))
+                         : fmt::format("{} ± {:.3g}", value, half);
+}
+
+void print_sampling(const RenderResult& r, const stats::Estimate& e, std::ostream& out) {
+    const SamplingSummary& s = *r.timing->sampling;
+    const double total = double(r.instructions.total);
+    fmt::print(out,
+               "sampled  ESTIMATES, {:.0f} % confidence: {} units of {} cycles after {} cycles "
+               "of warm-up, one per {} instructions (rate {}, seed {}); head and tail measured "
+               "whole ({:.1f} % of the instructions), {:.1f} % functionally warmed, {} cycles "
+               "simulated\n",
+               100 * e.confidence, s.units, s.options.unit_cycles, s.options.warmup_cycles,
+               s.period_instructions, s.options.rate, s.options.seed,
+               100 * double(s.head_instructions + s.tail_instructions) / total,
+               100 * double(s.warmed_instructions) / total, s.simulated_cycles);
+    const auto row = [&](std::string_view label, std::string_view name, std::string value) {
+        fmt::print(out, "         {:<22} {}\n", label, with_interval(e, name, std::move(value)));
+    };
+    row("frame cycles", "chip/cycles", fmt::format("{:.0f}", e.values.value("chip/cycles")));
+    row("issue rate", "chip/issue_rate", fmt::format("{:.4f}", e.values.value("chip/issue_rate")));
+    row("L1 hit rate", "chip/l1/hit_rate",
+        fmt::format("{:.4f}", e.values.value("chip/l1/hit_rate")));
+    row("L2 hit rate", "chip/l2/hit_rate",
+        fmt::format("{:.4f}", e.values.value("chip/l2/hit_rate")));
+    row("DRAM bytes read", "dram/bytes_read",
+        fmt::format("{:.0f}", e.values.value("dram/bytes_read")));
+    row("DRAM bytes written", "dram/bytes_written",
+        fmt::format("{:.0f}", e.values.value("dram/bytes_written")));
+}
+
+}  // namespace
+
+void print_summary(const RenderOptions& options, const RenderResult& r,
+                   const RunStatistics& statistics, std::ostream& out) {
     // What the command line overrode is marked, and the seed shown to kernels that read it.
     const auto overridden = [](uint32_t value) { return value != 0 ? " (set by option)" : ""; };
     const bool has_extras =
@@ -260,13 +311,15 @@ void print_summary(const RenderOptions& options, const RenderResult& r, std::ost
                    double(r.traversal.triangles_tested) / double(r.traversal.rays()),
                    r.traversal.max_stack_depth);
     if (r.timing) {
-        const timing::Chip& chip = *r.timing->chip;
-        const double seconds = double(chip.cycles()) / (options.chip.chip.clock_mhz * 1e6);
+        // From the statistics, so that a sampled run shows its estimates.
+        const double cycles = statistics.values.value("chip/cycles");
+        const double seconds = cycles / (options.chip.chip.clock_mhz * 1e6);
         fmt::print(out,
-                   "timing   {} cycles = {:.3f} ms at {} MHz ({:.1f} frames/s), {:.2f} "
+                   "timing   {}{:.0f} cycles = {:.3f} ms at {} MHz ({:.1f} frames/s), {:.2f} "
                    "instructions per TP-cycle{}\n",
-                   chip.cycles(), seconds * 1e3, options.chip.chip.clock_mhz, 1 / seconds,
-                   double(r.instructions.total) / (double(chip.cycles()) * r.threads),
+                   statistics.estimate ? "~" : "", cycles, seconds * 1e3,
+                   options.chip.chip.clock_mhz, 1 / seconds,
+                   double(r.instructions.total) / (cycles * r.threads),
                    r.traversal.rays() > 0 ? fmt::format(", {:.1f} M rays/s",
                                                         double(r.traversal.rays()) / seconds / 1e6)
                                           : "");
@@ -278,12 +331,14 @@ void print_summary(const RenderOptions& options, const RenderResult& r, std::ost
                    double(r.instructions.total) / r.run_seconds / 1e6);
     else
         fmt::print(out, "run      {:.3f} s\n", r.run_seconds);
+    if (statistics.estimate) print_sampling(r, *statistics.estimate, out);
 }
 
 nlohmann::ordered_json stats_document(const RenderOptions& options, const RenderResult& r,
-                                      const stats::Snapshot& snapshot,
+                                      const RunStatistics& statistics,
                                       const std::filesystem::path& json_path,
                                       const OutputPaths& outputs) {
+    const stats::Snapshot& snapshot = statistics.values;
     const std::filesystem::path base =
         json_path.has_parent_path() ? json_path.parent_path() : std::filesystem::path(".");
     const auto relative = [&](const std::filesystem::path& path) {
@@ -297,6 +352,8 @@ nlohmann::ordered_json stats_document(const RenderOptions& options, const Render
     run["kernel"] = options.kernel.generic_string();
     run["kernel_name"] = options.kernel.stem().string();
     run["engine"] = engine_name(options.engine);
+    // How the cycle-level engine ran: every cycle, or sampled (its figures are estimates).
+    if (r.timing) run["timing"] = r.timing->sampling ? "sampled" : "cycle";
     run["bvh_builder"] = scene::to_string(options.bvh.builder);
     run["max_leaf"] = options.bvh.max_leaf_size;
     run["width"] = r.scene.width;
@@ -317,7 +374,31 @@ nlohmann::ordered_json stats_document(const RenderOptions& options, const Render
     doc["units"] = stats::units_json(snapshot);
     if (const std::vector<std::string> regions = region_names(snapshot); !regions.empty())
         doc["regions"] = regions;
-    if (r.timing) doc["timeline"] = r.timing->timeline->json();
+    if (r.timing && r.timing->timeline) doc["timeline"] = r.timing->timeline->json();
+    if (r.timing && r.timing->sampling) {
+        const SamplingSummary& s = *r.timing->sampling;
+        nlohmann::ordered_json& sampling = doc["sampling"];
+        sampling["rate"] = s.options.rate;
+        sampling["unit_cycles"] = s.options.unit_cycles;
+        sampling["warmup_cycles"] = s.options.warmup_cycles;
+        sampling["seed"] = s.options.seed;
+        sampling["units"] = s.units;
+        sampling["period_instructions"] = s.period_instructions;
+        sampling["head_instructions"] = s.head_instructions;
+        sampling["body_instructions"] = s.body_instructions;
+        sampling["tail_instructions"] = s.tail_instructions;
+        sampling["warmed_instructions"] = s.warmed_instructions;
+        sampling["simulated_cycles"] = s.simulated_cycles;
+        sampling["estimated"] = statistics.estimate.has_value();
+        if (statistics.estimate) {
+            const stats::Estimate& e = *statistics.estimate;
+            sampling["confidence"] = e.confidence;
+            nlohmann::ordered_json intervals = nlohmann::ordered_json::object();
+            for (size_t i = 0; i < e.half_width.size(); ++i)
+                if (e.half_width[i] != 0) intervals[e.values.values()[i].name] = e.half_width[i];
+            doc["intervals"] = std::move(intervals);
+        }
+    }
     if (r.profile) doc["profile"] = profile_json(*r.profile);
     return doc;
 }

@@ -3,12 +3,14 @@
 #pragma once
 #include <filesystem>
 #include <iosfwd>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "sim/render/render.hpp"
+#include "sim/stats/estimate.hpp"
 #include "sim/stats/registry.hpp"
 
 namespace tpsim::render {
@@ -17,9 +19,21 @@ namespace tpsim::render {
 /// `result` must outlive every use of `registry`.
 void register_stats(const RenderResult& result, stats::Registry& registry);
 
+/// A render's statistics as values: every registered statistic read at the end of the run, or
+/// for a sampled run estimated from its units, with intervals. The registry refers to
+/// `result`, which must outlive it.
+struct RunStatistics {
+    stats::Registry registry;
+    stats::Snapshot values;
+    std::optional<stats::Estimate> estimate;  ///< a sampled run's (not one its head covered)
+};
+RunStatistics run_statistics(const RenderResult& result);
+
 /// The human summary the report leads with: scene, kernel and chip (the configuration fields
-/// that differ from the defaults), memory image by section, BVH, rays, cycles, run speed.
-void print_summary(const RenderOptions& options, const RenderResult& result, std::ostream& out);
+/// that differ from the defaults), memory image by section, BVH, rays, cycles, run speed; for
+/// a sampled run, what was sampled and the key estimates with their intervals.
+void print_summary(const RenderOptions& options, const RenderResult& result,
+                   const RunStatistics& statistics, std::ostream& out);
 
 /// The regions of the region/<r>/... statistics, in registration order (the table's rows).
 std::vector<std::string> region_names(const stats::Snapshot& snapshot);
@@ -35,10 +49,11 @@ struct OutputPaths {
 };
 
 /// The statistics file of a render (docs/statistics.md, "The statistics file"): run, config,
-/// `snapshot` as stats and units, regions, timeline and profile. Output paths are stored
+/// the statistics' values and units, regions, timeline and profile; for a sampled run also
+/// the sampling and every estimate's interval. Output paths are stored
 /// relative to the directory of `json_path`, so the files can move together.
 nlohmann::ordered_json stats_document(const RenderOptions& options, const RenderResult& result,
-                                      const stats::Snapshot& snapshot,
+                                      const RunStatistics& statistics,
                                       const std::filesystem::path& json_path,
                                       const OutputPaths& outputs);
 

@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cstring>
 
+#include <fmt/format.h>
+
+#include "sim/core/error.hpp"
+
 namespace tpsim::render {
 
 std::shared_ptr<TimingRun> run_timing(const core::Program& program, image::MemoryImage& image,
@@ -19,6 +23,27 @@ std::shared_ptr<TimingRun> run_timing(const core::Program& program, image::Memor
     timing::Chip& model = *run->chip;
     stats::Registry chip_stats;
     model.register_stats(chip_stats);
+    const auto report = [&] {
+        if (options.on_progress)
+            options.on_progress({std::min<uint64_t>(machine.global_register(0), options.pixels),
+                                 options.pixels, model.cycles()});
+    };
+    if (options.sampling) {
+        if (options.profile)
+            throw Error("the profile needs every cycle simulated: use --timing cycle");
+        SamplingSummary summary;
+        run->samples = run_sampled(model, chip_stats, *options.sampling, summary, report);
+        if (!summary.exact && summary.units < 2)
+            throw Error(fmt::format(
+                "sampled simulation measured {} unit{} before the threads ran out of work, too "
+                "few to estimate from; raise --sample-rate or shorten --sample-unit, or use "
+                "--timing cycle for a run this short",
+                summary.units, summary.units == 1 ? "" : "s"));
+        run->sampling = summary;
+        std::memcpy(image.words.data(), machine.memory().global().data(), image.bytes());
+        run->instructions = InstructionCounts::of(machine.counters());
+        return run;
+    }
     run->timeline = std::make_unique<Timeline>(
         chip_stats, chip.chip.num_tms * chip.chip.tps_per_tm,
         [&model] { return model.running_threads(); }, options.timeline_interval);
@@ -32,9 +57,7 @@ std::shared_ptr<TimingRun> run_timing(const core::Program& program, image::Memor
         if (model.cycles() == timeline.next_sample()) timeline.sample(model.cycles());
         if (model.cycles() == next_report) {
             next_report += kInterval;
-            if (options.on_progress)
-                options.on_progress({std::min<uint64_t>(machine.global_register(0), options.pixels),
-                                     options.pixels, model.cycles()});
+            report();
         }
     }
     timeline.sample(model.cycles());

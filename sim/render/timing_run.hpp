@@ -4,11 +4,13 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 #include "kernel/memory_map.hpp"
 #include "sim/core/machine.hpp"
 #include "sim/image/memory_image.hpp"
 #include "sim/render/render.hpp"
+#include "sim/render/sampling.hpp"
 #include "sim/render/timeline.hpp"
 #include "sim/timing/chip.hpp"
 #include "sim/timing/machine_source.hpp"
@@ -21,8 +23,11 @@ struct TimingRun {
     std::unique_ptr<core::Machine> machine;
     std::unique_ptr<timing::MachineSource> source;
     std::unique_ptr<timing::Chip> chip;
-    std::unique_ptr<Timeline> timeline;
+    std::unique_ptr<Timeline> timeline;  ///< none for a sampled run
     InstructionCounts instructions;
+    /// A sampled run: what it did, and what it measured for stats::estimate().
+    std::optional<SamplingSummary> sampling;
+    stats::UnitSamples samples;
 };
 
 /// What the chip is told about a run: the image's non-empty sections and the kernel's ELF
@@ -56,6 +61,8 @@ struct TimingRunOptions {
     uint64_t timeline_interval = 0;  ///< cycles between timeline samples; 0: adapt (Timeline)
     /// Collect the chip's per-instruction profile (Chip::profile(); about 11 % slower).
     bool profile = false;
+    /// Sampled simulation (sampling.hpp) instead of every cycle; no timeline, no profile.
+    std::optional<SamplingOptions> sampling;
 };
 
 /// Runs `program` over `image` (in place) on the chip `chip`. Throws core::Fault on a guest

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <ostream>
 #include <stdexcept>
 
@@ -26,6 +27,15 @@ bool valid_name(std::string_view name) {
 // output is identical for identical inputs on any host.
 std::string format_value(const Value& v) {
     return v.is_integer ? fmt::format("{}", v.integer) : fmt::format("{}", v.real);
+}
+
+/// An entry with its name and texts; the caller sets how its value is read.
+Entry leaf(std::string name, std::string description, std::string unit) {
+    Entry entry;
+    entry.name = std::move(name);
+    entry.description = std::move(description);
+    entry.unit = std::move(unit);
+    return entry;
 }
 
 }  // namespace
@@ -58,66 +68,123 @@ void Registry::add(Entry entry) {
 void Registry::add_counter(std::string name, const uint64_t& counter, std::string description,
                            std::string unit) {
     const uint64_t* p = &counter;
-    add({std::move(name), std::move(description), std::move(unit), [p] { return *p; }, {}});
+    Entry entry = leaf(std::move(name), std::move(description), std::move(unit));
+    entry.integer = [p] { return *p; };
+    add(std::move(entry));
+}
+
+void Registry::add_level(std::string name, const uint64_t& level, std::string description,
+                         std::string unit) {
+    const uint64_t* p = &level;
+    Entry entry = leaf(std::move(name), std::move(description), std::move(unit));
+    entry.integer = [p] { return *p; };
+    entry.additive = false;
+    add(std::move(entry));
 }
 
 void Registry::add_number(std::string name, const double& number, std::string description,
                           std::string unit) {
     const double* p = &number;
-    add({std::move(name), std::move(description), std::move(unit), {}, [p] { return *p; }});
+    Entry entry = leaf(std::move(name), std::move(description), std::move(unit));
+    entry.real = [p] { return *p; };
+    add(std::move(entry));
 }
 
 void Registry::add_derived(std::string name, std::function<double()> derive,
                            std::string description, std::string unit) {
-    add({std::move(name), std::move(description), std::move(unit), {}, std::move(derive)});
+    Entry entry = leaf(std::move(name), std::move(description), std::move(unit));
+    entry.real = std::move(derive);
+    add(std::move(entry));
+}
+
+void Registry::add_formula(std::string name, const std::vector<std::string_view>& inputs,
+                           std::function<double(std::span<const double>)> formula,
+                           std::string description, std::string unit) {
+    Entry entry = leaf(std::move(name), std::move(description), std::move(unit));
+    std::vector<Entry> parts;  // copies: the live value stays valid however entries_ grows
+    for (std::string_view input : inputs) {
+        entry.inputs.push_back(index(input));
+        parts.push_back(entries_[entry.inputs.back()]);
+    }
+    entry.real = [parts, formula] {
+        std::vector<double> values;
+        for (const Entry& part : parts)
+            values.push_back(part.value());
+        return formula(values);
+    };
+    entry.formula = std::move(formula);
+    add(std::move(entry));
 }
 
 void Registry::add_ratio(std::string name, std::string_view numerator, std::string_view denominator,
                          std::string description, std::string unit) {
-    // Copy the accessors so the ratio stays valid however entries_ grows.
-    const Entry num = at(numerator);
-    const Entry den = at(denominator);
-    add_derived(
-        std::move(name),
-        [num, den] {
-            const double d = den.value();
-            return d == 0 ? 0.0 : num.value() / d;
-        },
+    add_formula(
+        std::move(name), {numerator, denominator},
+        [](std::span<const double> v) { return v[1] == 0 ? 0.0 : v[0] / v[1]; },
         std::move(description), std::move(unit));
 }
 
 void Registry::add_sum(std::string name, std::string_view pattern, std::string description,
                        std::string unit) {
     std::vector<Entry> parts;
-    for (const Entry& e : entries_)
-        if (matches(pattern, e.name)) parts.push_back(e);
+    std::vector<size_t> inputs;
+    for (size_t i = 0; i < entries_.size(); ++i)
+        if (matches(pattern, entries_[i].name)) {
+            parts.push_back(entries_[i]);
+            inputs.push_back(i);
+        }
     if (parts.empty())
         throw std::invalid_argument(
             fmt::format("statistic sum '{}': no registered statistic matches '{}'", name, pattern));
     const bool all_integer =
         std::all_of(parts.begin(), parts.end(), [](const Entry& e) { return e.is_integer(); });
-    if (all_integer) {
-        add({std::move(name),
-             std::move(description),
-             std::move(unit),
-             [parts] {
-                 uint64_t sum = 0;
-                 for (const Entry& e : parts)
-                     sum += e.integer();
-                 return sum;
-             },
-             {}});
-    } else {
-        add_derived(
-            std::move(name),
-            [parts] {
-                double sum = 0;
-                for (const Entry& e : parts)
-                    sum += e.value();
-                return sum;
-            },
-            std::move(description), std::move(unit));
+    Entry entry = leaf(std::move(name), std::move(description), std::move(unit));
+    if (all_integer)
+        entry.integer = [parts] {
+            uint64_t sum = 0;
+            for (const Entry& e : parts)
+                sum += e.integer();
+            return sum;
+        };
+    else
+        entry.real = [parts] {
+            double sum = 0;
+            for (const Entry& e : parts)
+                sum += e.value();
+            return sum;
+        };
+    entry.inputs = std::move(inputs);
+    add(std::move(entry));
+}
+
+size_t Registry::index(std::string_view name) const {
+    for (size_t i = 0; i < entries_.size(); ++i)
+        if (entries_[i].name == name) return i;
+    throw std::out_of_range(fmt::format("no statistic named '{}' is registered", name));
+}
+
+Snapshot Registry::derive(Snapshot values) const {
+    std::vector<Value>& v = values.values();
+    if (v.size() != entries_.size())
+        throw std::invalid_argument("Registry::derive: the snapshot comes from another registry");
+    std::vector<double> inputs;
+    for (size_t i = 0; i < entries_.size(); ++i) {
+        const Entry& e = entries_[i];
+        if (e.inputs.empty()) continue;
+        if (!e.formula && v[i].is_integer) {
+            uint64_t sum = 0;
+            for (size_t input : e.inputs)
+                sum += v[input].integer;
+            v[i].integer = sum;
+            continue;
+        }
+        inputs.clear();
+        for (size_t input : e.inputs)
+            inputs.push_back(v[input].value());
+        v[i].real =
+            e.formula ? e.formula(inputs) : std::accumulate(inputs.begin(), inputs.end(), 0.0);
     }
+    return values;
 }
 
 const Entry& Registry::at(std::string_view name) const {
@@ -134,7 +201,7 @@ bool Registry::contains(std::string_view name) const {
 Snapshot::Snapshot(const Registry& registry) {
     values_.reserve(registry.entries().size());
     for (const Entry& e : registry.entries()) {
-        Value v{e.name, e.description, e.unit, e.is_integer()};
+        Value v{e.name, e.description, e.unit, e.is_integer(), e.additive};
         if (v.is_integer)
             v.integer = e.integer();
         else
@@ -160,8 +227,10 @@ Snapshot Snapshot::since(const Snapshot& earlier) const {
             throw std::invalid_argument(
                 fmt::format("Snapshot::since: '{}' against '{}': different registries", v.name,
                             earlier.values_[i].name));
-        if (v.is_integer)
+        if (v.is_integer && v.additive)
             v.integer -= earlier.values_[i].integer;
+        else if (v.is_integer)
+            continue;  // a level: its value at the end of the interval
         else
             v.real = std::numeric_limits<double>::quiet_NaN();
     }

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <functional>
 #include <iosfwd>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -22,10 +23,20 @@ struct Entry {
     std::string unit;                   ///< e.g. "cycles", "B/cycle"; empty if dimensionless
     std::function<uint64_t()> integer;  ///< set for integer entries
     std::function<double()> real;       ///< set for real entries
+    /// Integers that add up over time (counters and their sums: an interval subtracts them)
+    /// or a level read at one moment (a high-water mark).
+    bool additive = true;
+    /// A sum or formula: the entries (by index, registered earlier) it is computed from, and
+    /// how (formulas; none: the sum of the inputs). Registry::derive() recomputes it from any
+    /// snapshot's values, e.g. from estimated counters.
+    std::vector<size_t> inputs;
+    std::function<double(std::span<const double>)> formula;
 
     bool is_integer() const { return static_cast<bool>(integer); }
     double value() const { return integer ? static_cast<double>(integer()) : real(); }
 };
+
+class Snapshot;
 
 /// Registered statistics in registration order (that order is the print order, so output is
 /// deterministic). Entries point at storage owned elsewhere: keep the owners alive while
@@ -38,9 +49,20 @@ public:
     /// Registers a real-valued quantity that the caller updates (e.g. host seconds).
     void add_number(std::string name, const double& number, std::string description,
                     std::string unit = "");
-    /// Registers a value computed from others when printed (ratios, rates).
+    /// Registers an integer level, not a count: a high-water mark. An interval keeps its
+    /// later value.
+    void add_level(std::string name, const uint64_t& level, std::string description,
+                   std::string unit = "");
+    /// Registers a value read when printed that depends on no other statistic (a property of
+    /// the run: scene size, host seconds).
     void add_derived(std::string name, std::function<double()> derive, std::string description,
                      std::string unit = "");
+    /// Registers a value computed from already registered entries (rates, utilisations):
+    /// `formula` gets their values in the order of `inputs`. Throws std::out_of_range for an
+    /// unknown input.
+    void add_formula(std::string name, const std::vector<std::string_view>& inputs,
+                     std::function<double(std::span<const double>)> formula,
+                     std::string description, std::string unit = "");
     /// numerator / denominator of two already registered entries; 0 when the denominator is 0.
     void add_ratio(std::string name, std::string_view numerator, std::string_view denominator,
                    std::string description, std::string unit = "");
@@ -51,8 +73,13 @@ public:
                  std::string unit = "");
 
     const std::vector<Entry>& entries() const { return entries_; }
+    /// `values` (a snapshot of this registry whose counters may have been replaced, e.g. by
+    /// estimates) with every sum and formula recomputed from them, in registration order.
+    Snapshot derive(Snapshot values) const;
     /// The entry called `name`; throws std::out_of_range naming it if absent.
     const Entry& at(std::string_view name) const;
+    /// Index of the entry called `name` in entries(); throws std::out_of_range naming it.
+    size_t index(std::string_view name) const;
     bool contains(std::string_view name) const;
     double value(std::string_view name) const { return at(name).value(); }
 
@@ -68,6 +95,7 @@ bool matches(std::string_view pattern, std::string_view name);
 struct Value {
     std::string name, description, unit;
     bool is_integer = false;
+    bool additive = true;  ///< Entry::additive
     uint64_t integer = 0;  ///< when is_integer
     double real = 0;       ///< otherwise
 
@@ -81,13 +109,14 @@ public:
     explicit Snapshot(const Registry& registry);
 
     const std::vector<Value>& values() const { return values_; }
+    std::vector<Value>& values() { return values_; }
     /// The value called `name`; throws std::out_of_range naming it if absent.
     const Value& at(std::string_view name) const;
     double value(std::string_view name) const { return at(name).value(); }
 
-    /// The interval from `earlier` to this snapshot of the same registry: integers (counters
-    /// and their sums) subtract; reals (ratios, rates, host times) are not additive and become
-    /// NaN, to be recomputed from the interval's counters by whoever needs them.
+    /// The interval from `earlier` to this snapshot of the same registry: counters and their
+    /// sums subtract, levels keep this snapshot's value; reals (ratios, rates, host times) are
+    /// not additive and become NaN (Registry::derive() recomputes the formulas).
     Snapshot since(const Snapshot& earlier) const;
 
 private:

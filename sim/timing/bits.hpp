@@ -20,6 +20,9 @@ static_assert(count_bits(0) == 0 && count_bits(~uint64_t{0}) == 64 && count_bits
 inline void set_bit(std::vector<uint64_t>& bits, uint32_t i) {
     bits[i >> 6] |= uint64_t{1} << (i & 63);
 }
+inline bool test_bit(const std::vector<uint64_t>& bits, uint32_t i) {
+    return bits[i >> 6] >> (i & 63) & 1;
+}
 inline void clear_bit(std::vector<uint64_t>& bits, uint32_t i) {
     bits[i >> 6] &= ~(uint64_t{1} << (i & 63));
 }

@@ -138,21 +138,34 @@ bool Cache::drain_write_buffer(uint64_t now) {
     return any;
 }
 
+bool Cache::install(uint32_t line) {
+    Way* set = &ways_[size_t{set_of(line)} * config_.ways];
+    Way* victim = &set[0];
+    for (uint32_t w = 0; w < config_.ways; ++w) {
+        if (!set[w].valid) {
+            victim = &set[w];
+            break;
+        }
+        if (set[w].last_use < victim->last_use) victim = &set[w];
+    }
+    const bool evicted = victim->valid;
+    *victim = {line, true, ++use_clock_};
+    return evicted;
+}
+
+bool Cache::warm(uint32_t addr, bool write) {
+    const uint32_t line = line_of(addr);
+    if (Way* way = find(line)) {
+        way->last_use = ++use_clock_;
+        return true;
+    }
+    if (!write) install(line);
+    return false;
+}
+
 void Cache::fill(uint64_t now, uint32_t line_addr) {
     const uint32_t line = line_of(line_addr);
-    if (!find(line)) {
-        Way* set = &ways_[size_t{set_of(line)} * config_.ways];
-        Way* victim = &set[0];
-        for (uint32_t w = 0; w < config_.ways; ++w) {
-            if (!set[w].valid) {
-                victim = &set[w];
-                break;
-            }
-            if (set[w].last_use < victim->last_use) victim = &set[w];
-        }
-        counters_.evictions += victim->valid;
-        *victim = {line, true, ++use_clock_};
-    }
+    if (!find(line)) counters_.evictions += install(line);
     for (Mshr& m : mshrs_) {
         if (!m.busy || m.line != line) continue;
         for (const MemRequest& waiter : m.waiters)

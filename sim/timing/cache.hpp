@@ -70,6 +70,10 @@ public:
     /// The line holding `line_addr` arrives from the next level in cycle `now`: it is
     /// installed (evicting the LRU way) and every merged waiter gets a reply at now + hit_latency.
     void fill(uint64_t now, uint32_t line_addr);
+    /// Functional warming (Chip::warm): the tag and LRU state `access` and `fill` would leave
+    /// behind for this access, without timing, MSHRs or counters. Returns whether it hit; a
+    /// load that misses installs its line at once.
+    bool warm(uint32_t addr, bool write);
     /// Pops the oldest reply whose data is ready by `now` (inline: asked every TM and cycle).
     bool pop_reply(uint64_t now, MemReply& reply) {
         if (replies_.empty() || replies_.front().ready > now) return false;
@@ -115,6 +119,8 @@ private:
     };
 
     Way* find(uint32_t line);
+    /// Puts `line` (not present) into the LRU way of its set; returns whether it evicted one.
+    bool install(uint32_t line);
     CacheOutcome combine(uint64_t now, const MemRequest& request);
     /// Sends buffered line `index` on as one line write, visible below from `at`.
     void write_line(size_t index, uint64_t at);

@@ -66,6 +66,28 @@ public:
     /// the chip has not finished by cycle `max_cycles`.
     uint64_t run(uint64_t max_cycles = UINT64_MAX);
 
+    /// Sampled simulation (sim/render/sampled_run.hpp) switches between this cycle-level
+    /// model and functional warming, through a quiescent chip:
+    /// drain() stops fetching and runs cycles until no fetched instruction and no memory or
+    /// atomic request is in flight (threads waiting at a barrier or for a semaphore may stay
+    /// waiting); returns finished(). Calls to run_until() fetch again.
+    bool drain();
+    /// What warm() did.
+    struct Warming {
+        uint64_t instructions = 0;  ///< instructions executed
+        bool reached_exit = false;  ///< a thread's next instruction is its exit
+    };
+    /// Functional warming of a drained chip: the threads execute about `instructions` in all,
+    /// round-robin in short turns, without cycles; every global load and store updates the
+    /// state it would leave behind in the cycle-level model (L1 and L2 tags and LRU order, DRAM
+    /// open rows), so the next cycle-level stretch starts warm. A thread whose next instruction
+    /// is its exit or a synchronisation instruction stops there holding it, for the cycle-level
+    /// model to issue; warming ends early if every thread has stopped. No counter moves.
+    Warming warm(uint64_t instructions);
+
+    /// Instructions executed by warm() so far.
+    uint64_t warmed_instructions() const { return warmed_instructions_; }
+
     uint64_t cycles() const { return cycles_; }
     /// Threads that have not exited yet.
     uint32_t running_threads() const;
@@ -85,9 +107,15 @@ public:
 
 private:
     struct Tm;
+    struct WarmingObserver;
     // The cycle loop is instantiated for the concrete MachineSource (its calls inline) and for
     // any other InstructionSource (tests' scripted sources); the constructor picks one.
     template <class Source> bool run_cycles(uint64_t end);
+    template <class Source> Warming warm_threads(uint64_t instructions);
+    /// The state one global access would leave behind in TM `tm`'s L1, its L2 and DRAM.
+    void warm_access(Tm& tm, uint32_t addr, bool store);
+    /// No fetched instruction and no memory or atomic request in flight (drain()).
+    bool quiescent() const;
     bool busy() const;  // anything in flight except lines in write-combining buffers
     bool drained() const;
     /// Index of the region holding `addr` in layout_.regions, or other_region_.
@@ -116,6 +144,8 @@ private:
     ChipLayout layout_;
     InstructionSource& source_;
     bool (Chip::*run_cycles_)(uint64_t end) = &Chip::run_cycles<InstructionSource>;
+    Warming (Chip::*warm_threads_)(uint64_t instructions) = &Chip::warm_threads<InstructionSource>;
+    bool fetching_ = true;                      // false while drain() empties the chip
     core::Machine* clocked_machine_ = nullptr;  // reads cycles_ through its cycle CSRs
     std::vector<std::unique_ptr<Tm>> tms_;
     std::vector<Cache> l2s_;
@@ -124,6 +154,7 @@ private:
     std::array<Pool, size_t(isa::FuClass::Count)> pool_of_{};
     std::array<uint32_t, size_t(Pool::Count)> latency_of_{};
     uint64_t cycles_ = 0;
+    uint64_t warmed_instructions_ = 0;
     uint64_t progress_ = 0;  // bumped whenever anything issues or returns
     uint64_t last_progress_ = 0, last_progress_cycle_ = 0;  // for the deadlock detector
     bool finished_ = false;

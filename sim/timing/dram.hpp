@@ -71,6 +71,11 @@ public:
     /// Pops the next read reply whose data has fully arrived by `now`, in (ready, issue) order.
     bool pop_reply(uint64_t now, MemReply& reply);
     bool idle() const;
+    /// Functional warming (Chip::warm) of an idle DRAM: the access leaves its row open.
+    void warm(uint32_t addr) {
+        const DramLocation where = locate(addr);
+        channels_[where.channel].banks[where.bank].open_row = where.row;
+    }
     /// Every request served (read or write) since the owner last cleared it, in issue order:
     /// the chip charges their bytes to regions, instructions and work items.
     std::vector<MemRequest>& served() { return served_; }

@@ -72,6 +72,46 @@ public:
         next_pc_[thread] = a.next < a.size ? a.records[a.next].pc : machine_.next_pc(thread);
     }
 
+    /// Functional warming (Chip::warm): thread `thread` executes up to `budget` instructions,
+    /// first those it has run ahead, and `observer` hears of their loads, stores and atomic
+    /// increments (core::ThreadEnv); stops after an exit or a synchronisation instruction,
+    /// leaving its record in `last` (and returns true). `executed` counts the instructions.
+    template <class Observer>
+    bool warm(uint32_t thread, uint64_t budget, uint64_t& executed, StepInfo& last,
+              Observer& observer) {
+        Ahead& a = ahead_[thread];
+        executed = 0;
+        bool stopped = false;
+        while (a.next < a.size && executed < budget && !stopped) {
+            const StepInfo& s = a.records[a.next++];
+            ++executed;
+            stopped = replay(s, last, observer);
+        }
+        if (executed < budget && !stopped) {
+            if (a.fault) std::rethrow_exception(std::exchange(a.fault, nullptr));
+            uint64_t more = 0;
+            stopped = machine_.run_observed(thread, budget - executed, more, last, observer);
+            executed += more;
+        }
+        next_pc_[thread] = a.next < a.size ? a.records[a.next].pc : machine_.next_pc(thread);
+        return stopped;
+    }
+
+    /// What `observer` hears of an instruction already executed (warm()): its access or
+    /// atomic increment; true (its record copied to `last`) if it is an exit or a
+    /// synchronisation, where warming stops.
+    template <class Observer>
+    static bool replay(const StepInfo& s, StepInfo& last, Observer& observer) {
+        if (s.exited || s.insn->fu == isa::FuClass::Sync) {
+            last = s;
+            return true;
+        }
+        if (s.mem_bytes != 0) observer.access(s.mem_address, s.mem_bytes, s.mem_store);
+        if (s.insn->fu == isa::FuClass::Atomic)
+            observer.atomic(uint32_t(s.insn->imm), s.atomic_result);
+        return false;
+    }
+
 private:
     static constexpr uint32_t kAhead = 128;  // records buffered per thread
     struct Ahead {

@@ -200,3 +200,23 @@ TEST_CASE("write-combining merges stores to a line into one line write", "[cache
     CHECK_FALSE(cache.holds_combined_lines());
     CHECK_FALSE(cache.drain_write_buffer(now));
 }
+
+TEST_CASE("warming leaves the tags and LRU order of the accesses, without counting them",
+          "[cache][sampling]") {
+    Cache cache(kSmall);
+    CHECK_FALSE(cache.warm(0x100, false));  // a load misses and installs its line at once
+    CHECK(cache.contains(0x100));
+    CHECK(cache.warm(0x104, false));       // the same line now hits
+    CHECK_FALSE(cache.warm(0x800, true));  // a store goes around: no line
+    CHECK_FALSE(cache.contains(0x800));
+    // LRU as access/fill keep it: of two lines in a set, the one touched last stays.
+    cache.warm(0x100 + kSetStride, false);
+    cache.warm(0x100, false);
+    cache.warm(0x100 + 2 * kSetStride, false);
+    CHECK(cache.contains(0x100));
+    CHECK_FALSE(cache.contains(0x100 + kSetStride));
+    CHECK(cache.counters().reads == 0);
+    CHECK(cache.counters().evictions == 0);
+    // The cycle-level model finds the warmed line.
+    CHECK(cache.access(0, load(0x100)) == CacheOutcome::Hit);
+}
