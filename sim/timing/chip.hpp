@@ -82,7 +82,8 @@ public:
     /// state it would leave behind in the cycle-level model (L1 and L2 tags and LRU order, DRAM
     /// open rows), so the next cycle-level stretch starts warm. A thread whose next instruction
     /// is its exit or a synchronisation instruction stops there holding it, for the cycle-level
-    /// model to issue; warming ends early if every thread has stopped. No counter moves.
+    /// model to issue; warming ends early when a thread reaches its exit (the run's ragged end
+    /// begins) or every thread has stopped. No counter moves.
     Warming warm(uint64_t instructions);
 
     /// Instructions executed by warm() so far.
@@ -112,8 +113,9 @@ private:
     // any other InstructionSource (tests' scripted sources); the constructor picks one.
     template <class Source> bool run_cycles(uint64_t end);
     template <class Source> Warming warm_threads(uint64_t instructions);
-    /// The state one global access would leave behind in TM `tm`'s L1, its L2 and DRAM.
-    void warm_access(Tm& tm, uint32_t addr, bool store);
+    /// The state one global access would leave behind in TM `tm`'s L1, its L2 and DRAM;
+    /// returns roughly how long a load would wait below the L1 (0 for a hit or a store).
+    uint32_t warm_access(Tm& tm, uint32_t addr, bool store);
     /// No fetched instruction and no memory or atomic request in flight (drain()).
     bool quiescent() const;
     bool busy() const;  // anything in flight except lines in write-combining buffers
