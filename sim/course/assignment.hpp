@@ -35,6 +35,9 @@ struct ImageThresholds {
     double min_psnr = 30;      ///< dB over every channel of the 8-bit sRGB images
     int tolerance = 4;         ///< a pixel differs when a channel is off by more than this /255
     double max_differing = 0;  ///< share of pixels allowed to differ
+    /// Compare the images' averages over blocks of block x block pixels (in linear light)
+    /// rather than single pixels: Monte Carlo noise averages away, a wrong light level does not.
+    int block = 1;
 };
 
 /// Per-assignment explanations for the likely cause of a failed image.

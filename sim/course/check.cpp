@@ -76,6 +76,29 @@ Rgb8 undone(const Rgb8& image, Mistake mistake) {
     return out;
 }
 
+/// The image with each block x block square (cut short at the right and bottom edges) replaced
+/// by its average in linear light, as the comparison sees it when [image] block > 1.
+Rgb8 block_averages(const Rgb8& image, int block) {
+    Rgb8 out = image;
+    for (int by = 0; by < image.height; by += block)
+        for (int bx = 0; bx < image.width; bx += block) {
+            const int ey = std::min(by + block, image.height);
+            const int ex = std::min(bx + block, image.width);
+            for (int c = 0; c < 3; ++c) {
+                float sum = 0;
+                for (int y = by; y < ey; ++y)
+                    for (int x = bx; x < ex; ++x)
+                        sum += render::decode_srgb(
+                            image.pixels[(size_t(y) * image.width + x) * 3 + c]);
+                const uint8_t mean = render::encode_srgb(sum / float((ey - by) * (ex - bx)));
+                for (int y = by; y < ey; ++y)
+                    for (int x = bx; x < ex; ++x)
+                        out.pixels[(size_t(y) * image.width + x) * 3 + c] = mean;
+            }
+        }
+    return out;
+}
+
 bool one_colour(const Rgb8& image) {
     for (size_t i = 3; i < image.pixels.size(); ++i)
         if (image.pixels[i] != image.pixels[i % 3]) return false;
@@ -273,13 +296,18 @@ CheckReport check(const Assignment& a, const CheckOptions& o) {
             report.results.push_back({scene.name, "image", true,
                                       fmt::format("reference written: {}", image_path.string())});
         } else {
-            const Rgb8 image = read_rgb8(image_path, "the kernel's image");
-            const Rgb8 ref = read_rgb8(scene.reference, "reference image");
+            Rgb8 image = read_rgb8(image_path, "the kernel's image");
+            Rgb8 ref = read_rgb8(scene.reference, "reference image");
             if (ref.width != image.width || ref.height != image.height)
                 throw Error(fmt::format("reference image {} is {}x{} but the assignment renders "
                                         "{}x{}; render it again with --update-references",
                                         scene.reference.string(), ref.width, ref.height,
                                         image.width, image.height));
+            const int block = a.image.block;
+            if (block > 1) {
+                image = block_averages(image, block);
+                ref = block_averages(ref, block);
+            }
             const ImageComparison c = compare_rgb8(image.pixels, ref.pixels, a.image.tolerance);
             CheckResult r{scene.name, "image", within(c, a.image), ""};
             const std::string psnr =
@@ -287,9 +315,10 @@ CheckReport check(const Assignment& a, const CheckOptions& o) {
                     ? "identical to the reference"
                     : fmt::format("PSNR {:.1f} dB {} {:g} dB required", c.psnr,
                                   c.psnr >= a.image.min_psnr ? ">=" : "<", a.image.min_psnr);
-            r.detail = fmt::format("{}; {} of pixels differ by more than {}/255 ({} allowed)", psnr,
-                                   percent(c.differing_share), a.image.tolerance,
-                                   percent(a.image.max_differing));
+            r.detail = fmt::format(
+                "{}{}; {} of pixels differ by more than {}/255 ({} allowed)",
+                block > 1 ? fmt::format("{}x{}-pixel averages: ", block, block) : "", psnr,
+                percent(c.differing_share), a.image.tolerance, percent(a.image.max_differing));
             if (!r.passed) r.detail += " — " + likely_cause(image, ref, c, a);
             report.results.push_back(std::move(r));
             const std::filesystem::path diff = o.output_dir / (stem + ".diff.png");
