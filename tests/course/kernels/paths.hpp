@@ -40,8 +40,9 @@ inline Vec3 normalized(Vec3 v) {
     return v * (1.0f / trax_sqrt(dot(v, v)));
 }
 
-template <Variant kVariant> Vec3 radiance(const BvhTraversal& bvh, const Shading& s, Vec3 origin,
-                                          Vec3 dir, ThreadTotals& totals) {
+template <Variant kVariant>
+Vec3 radiance(const BvhTraversal& bvh, const Shading& s, Vec3 origin, Vec3 dir,
+              ThreadTotals& totals) {
     Vec3 sum{0.0f, 0.0f, 0.0f};
     Vec3 weight{1.0f, 1.0f, 1.0f};
     const int bounces = kVariant == Variant::direct_only ? 2 : kMaxBounces;
@@ -95,8 +96,8 @@ template <Variant kVariant> void render() {
         Vec3 sum{0.0f, 0.0f, 0.0f};
         for (int i = 0; i < samples; ++i) {
             const float jy = trax_rand(), jx = trax_rand();
-            const Vec3 dir = corner + right * ((x + jx) / float(width)) +
-                             down * ((y + jy) / float(height));
+            const Vec3 dir =
+                corner + right * ((x + jx) / float(width)) + down * ((y + jy) / float(height));
             sum = sum + radiance<kVariant>(bvh, s, eye, dir, totals);
         }
         const Vec3 c = sum * (1.0f / float(samples));
