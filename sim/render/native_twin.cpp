@@ -81,9 +81,9 @@ trax::KernelOutput collect_output(const char* output, const uint32_t* lengths, u
     return trax::KernelOutput::from_parts(std::move(threads), limit, dropped);
 }
 
-/// A fault the twin found and reported (a write into the scene, a local-store overflow, a
-/// deadlock ...), with what the kernel printed before it. (After a crash by a signal the output
-/// is lost with the child's memory: the twin hands it over only when it ends by itself.)
+/// A fault the twin found and reported (a write into the scene, a global register that does not
+/// exist, a deadlock ...), with what the kernel printed before it. (After a crash by a signal the
+/// output is lost with the child's memory: the twin hands it over only when it ends by itself.)
 core::KernelError twin_error(const char* error, size_t capacity, trax::KernelOutput printed) {
     return core::KernelError(error[0] != '\0' ? std::string(error, strnlen(error, capacity))
                                               : "the native twin failed without saying why",
