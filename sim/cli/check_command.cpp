@@ -33,12 +33,25 @@ int run_check(const CheckCommandOptions& o) {
             fmt::format("--output-dir '{}' is not a directory; create it first", o.output_dir));
     course::CheckOptions options;
     options.kernel = o.kernel;
+    if (!assignment.baseline.empty()) {
+        options.baseline_kernel =
+            std::filesystem::path(TPSIM_KERNEL_DIR) / (assignment.baseline + ".elf");
+        if (!std::filesystem::is_regular_file(options.baseline_kernel, ec))
+            throw Error(fmt::format("assignment {} compares with tpsim's kernel '{}', which is not "
+                                    "built (no {}); build it: cmake --build build --target {}_elf",
+                                    assignment.id, assignment.baseline,
+                                    options.baseline_kernel.string(), assignment.baseline));
+    }
     options.output_dir = o.output_dir;
     options.update_references = o.update_references;
     ProgressLine progress;
     options.on_scene = [&](size_t i, const course::AssignmentScene& scene) {
         progress.start(fmt::format("check {}: scene {} ({} of {}) ", assignment.id, scene.name,
                                    i + 1, assignment.scenes.size()));
+    };
+    options.on_baseline = [&](const course::AssignmentScene& scene) {
+        progress.start(fmt::format("check {}: scene {}, baseline {} ", assignment.id, scene.name,
+                                   assignment.baseline));
     };
     options.on_progress = [&](const render::Progress& p) { progress.update(p); };
 

@@ -6,8 +6,11 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <string_view>
 
 #include <CLI/CLI.hpp>
+
+#include "kernel/kernel_output.hpp"
 
 namespace tpsim::cli {
 
@@ -45,6 +48,10 @@ void check_output_path(const std::filesystem::path& path, const std::string& wha
 /// Writes `text` to `path`, throwing tpsim::Error naming both on failure.
 void write_output(const std::filesystem::path& path, const std::string& text,
                   const std::string& what);
+
+/// What the kernel printed, under `heading`, in thread order; then, on stderr, one note if some
+/// of it was dropped. Nothing when it printed nothing.
+void print_kernel_output(const trax::KernelOutput& output, std::string_view heading);
 
 Command add_exec_command(CLI::App& app);
 Command add_render_command(CLI::App& app);

@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "sim/cli/commands.hpp"
+#include "sim/core/fault.hpp"
 
 int main(int argc, char** argv) {
     CLI::App app{"tpsim: a cycle-counting simulator of TRaX ray-tracing hardware"};
@@ -41,6 +42,13 @@ int main(int argc, char** argv) {
     try {
         for (const tpsim::cli::Command& command : commands)
             if (command.parser->parsed()) status = command.run();
+    } catch (const tpsim::core::KernelError& e) {
+        // A kernel that failed: first what it printed until then, since a student debugging it
+        // with trax_printf needs that most now, then the error's line.
+        tpsim::cli::print_kernel_output(e.output(),
+                                        "kernel output before the error (by thread):\n");
+        fmt::print(stderr, "tpsim: {}\n", e.what());
+        return 2;
     } catch (const std::exception& e) {
         // Every tpsim error is one line saying what, where and how to fix it.
         fmt::print(stderr, "tpsim: {}\n", e.what());

@@ -1,4 +1,6 @@
-// Output files of the subcommands: checked before the work starts, written in one piece.
+// Output of the subcommands: files checked before the work starts and written in one piece, and
+// what a kernel printed.
+#include <cstdio>
 #include <fstream>
 
 #include <fmt/format.h>
@@ -21,6 +23,14 @@ void write_output(const std::filesystem::path& path, const std::string& text,
     std::ofstream out(path, std::ios::binary);
     out << text;
     if (!out.flush()) throw Error(fmt::format("cannot write {} to '{}'", what, path.string()));
+}
+
+void print_kernel_output(const trax::KernelOutput& output, std::string_view heading) {
+    if (output.empty()) return;
+    fmt::print("{}{}", heading, output.tagged());
+    std::fflush(stdout);  // before the note (and an error line) on stderr
+    if (const std::string note = output.truncation_note(); !note.empty())
+        fmt::print(stderr, "tpsim: warning: {}\n", note);
 }
 
 }  // namespace tpsim::cli

@@ -39,15 +39,6 @@ std::filesystem::path resolve_kernel(const std::string& kernel) {
     return built;
 }
 
-/// What the kernel printed, after the summary, and once a note if some was dropped.
-void print_kernel_output(const trax::KernelOutput& output) {
-    if (output.empty()) return;
-    fmt::print("\nkernel output (by thread):\n{}", output.tagged());
-    std::fflush(stdout);  // before the note on stderr
-    if (const std::string note = output.truncation_note(); !note.empty())
-        fmt::print(stderr, "tpsim: warning: {}\n", note);
-}
-
 /// A whole number in [lo, hi], for the image overrides: the message says the limits.
 CLI::Validator whole_number_in(uint32_t lo, uint32_t hi) {
     return CLI::Validator(
@@ -172,7 +163,7 @@ int run_render(RenderCommandOptions& o) {
     render::print_summary(options, result, statistics, std::cout);
     fmt::print("image    {}\n", output.string());
     render::print_traffic(snapshot, options.chip.l2.line_bytes, std::cout);
-    print_kernel_output(result.output);
+    print_kernel_output(result.output, "\nkernel output (by thread):\n");
     if (result.profile) {
         fmt::print("\n");
         render::print_profile(*result.profile, std::cout);

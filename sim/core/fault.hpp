@@ -1,10 +1,12 @@
 // Guest faults: what a thread did wrong, before and after the machine adds where it happened.
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <string_view>
 
 #include "isa/hart.hpp"
+#include "kernel/kernel_output.hpp"
 #include "sim/core/error.hpp"
 
 namespace tpsim::core {
@@ -43,11 +45,25 @@ struct GuestFault {
     uint32_t mtval = 0;         ///< its mtval (the faulting address)
 };
 
-/// The one-line, user-facing fault.
-class Fault : public Error {
+/// A run of a kernel that stopped with an error (a fault, on any engine), carrying what the
+/// kernel printed until then: the command shows it before the error's one line, because a
+/// student debugging with trax_printf needs it most when the kernel fails.
+class KernelError : public Error {
 public:
-    Fault(FaultKind kind, uint32_t thread, uint32_t pc, const std::string& message)
-        : Error(message), kind_(kind), thread_(thread), pc_(pc) {}
+    KernelError(const std::string& message, trax::KernelOutput output)
+        : Error(message), output_(std::make_shared<const trax::KernelOutput>(std::move(output))) {}
+    const trax::KernelOutput& output() const { return *output_; }
+
+private:
+    std::shared_ptr<const trax::KernelOutput> output_;  ///< shared: exceptions are copied
+};
+
+/// The one-line, user-facing fault of a simulated thread.
+class Fault : public KernelError {
+public:
+    Fault(FaultKind kind, uint32_t thread, uint32_t pc, const std::string& message,
+          trax::KernelOutput output)
+        : KernelError(message, std::move(output)), kind_(kind), thread_(thread), pc_(pc) {}
     FaultKind kind() const { return kind_; }
     uint32_t thread() const { return thread_; }
     uint32_t pc() const { return pc_; }

@@ -91,7 +91,8 @@ void Machine::fault(uint32_t id, uint32_t pc, const GuestFault& what) {
     throw Fault(what.kind, id, pc,
                 fmt::format("{} in thread {} at pc {:#010x}{}: {}{}; {}", to_string(what.kind), id,
                             pc, where.empty() ? "" : " (" + where + ")", instruction, what.detail,
-                            what.hint));
+                            what.hint),
+                output_);
 }
 
 void Machine::fetch_fault(uint32_t id, uint32_t pc) {

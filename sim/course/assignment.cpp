@@ -1,6 +1,7 @@
 #include "sim/course/assignment.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <initializer_list>
 
@@ -81,9 +82,9 @@ private:
 
 void read_render(const Reader& r, const toml::table& t, const std::filesystem::path& dir,
                  Assignment& a) {
-    r.allow_keys(
-        t, "render.",
-        {"width", "height", "samples_per_pixel", "chip", "max_pixel_instructions", "slow_hint"});
+    r.allow_keys(t, "render.",
+                 {"width", "height", "samples_per_pixel", "chip", "max_pixel_instructions",
+                  "slow_hint", "baseline"});
     if (auto* n = t.get("width")) a.width = uint32_t(r.integer(*n, "render.width", 1, 4096));
     if (auto* n = t.get("height")) a.height = uint32_t(r.integer(*n, "render.height", 1, 4096));
     if (auto* n = t.get("samples_per_pixel"))
@@ -93,15 +94,26 @@ void read_render(const Reader& r, const toml::table& t, const std::filesystem::p
         a.max_pixel_instructions =
             r.integer(*n, "render.max_pixel_instructions", 1, int64_t(1) << 40);
     if (auto* n = t.get("slow_hint")) a.slow_hint = r.string(*n, "render.slow_hint");
+    if (auto* n = t.get("baseline")) {
+        a.baseline = r.string(*n, "render.baseline");
+        if (!std::all_of(a.baseline.begin(), a.baseline.end(), [](char c) {
+                return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+            }))
+            r.fail(n->source(), fmt::format("render.baseline must name one of tpsim's kernels "
+                                            "(e.g. \"tracer\"), got \"{}\"",
+                                            a.baseline));
+    }
 }
 
 void read_image(const Reader& r, const toml::table& t, Assignment& a) {
-    r.allow_keys(t, "image.", {"min_psnr", "tolerance", "max_differing", "brighter", "darker"});
+    r.allow_keys(t, "image.",
+                 {"min_psnr", "tolerance", "max_differing", "block", "brighter", "darker"});
     if (auto* n = t.get("min_psnr")) a.image.min_psnr = r.number(*n, "image.min_psnr", 0, 200);
     if (auto* n = t.get("tolerance"))
         a.image.tolerance = int(r.integer(*n, "image.tolerance", 0, 255));
     if (auto* n = t.get("max_differing"))
         a.image.max_differing = r.number(*n, "image.max_differing", 0, 1);
+    if (auto* n = t.get("block")) a.image.block = int(r.integer(*n, "image.block", 1, 64));
     if (auto* n = t.get("brighter")) a.hints.brighter = r.string(*n, "image.brighter");
     if (auto* n = t.get("darker")) a.hints.darker = r.string(*n, "image.darker");
 }
@@ -178,14 +190,29 @@ Assignment load_assignment(const std::filesystem::path& toml_file) {
 
     if (auto* budgets = root.get("budgets"))
         for_each_table(r, *budgets, "budgets", [&](const toml::table& t, const std::string& entry) {
-            r.allow_keys(t, entry + ".", {"stat", "per", "max", "min", "scenes", "hint"});
+            r.allow_keys(t, entry + ".",
+                         {"stat", "per", "max", "min", "max_ratio", "min_ratio", "scenes", "hint"});
             Budget b;
             const toml::node* stat = t.get("stat");
-            if (!stat || !(t.get("max") || t.get("min")))
-                r.fail(t.source(), fmt::format("{} needs stat and max or min", entry));
+            if (!stat ||
+                !(t.get("max") || t.get("min") || t.get("max_ratio") || t.get("min_ratio")))
+                r.fail(t.source(),
+                       fmt::format("{} needs stat and max, min, max_ratio or min_ratio", entry));
             b.stat = r.string(*stat, entry + ".stat");
             if (auto* n = t.get("max")) b.max = r.number(*n, entry + ".max", 0, 1e300);
             if (auto* n = t.get("min")) b.min = r.number(*n, entry + ".min", 0, 1e300);
+            const auto ratio = [&](const char* key) -> std::optional<double> {
+                const toml::node* n = t.get(key);
+                if (!n) return std::nullopt;
+                if (a.baseline.empty())
+                    r.fail(n->source(),
+                           fmt::format("{}.{} compares with a baseline kernel, but the assignment "
+                                       "names none: set render.baseline (e.g. \"tracer\")",
+                                       entry, key));
+                return r.number(*n, entry + "." + key, 0, 1e6);
+            };
+            b.max_ratio = ratio("max_ratio");
+            b.min_ratio = ratio("min_ratio");
             if (auto* n = t.get("per")) b.per = r.string(*n, entry + ".per");
             if (auto* n = t.get("hint")) b.hint = r.string(*n, entry + ".hint");
             if (auto* n = t.get("scenes")) {

@@ -22,7 +22,10 @@ struct AssignmentScene {
 struct Budget {
     std::string stat;  ///< a statistics key (docs/statistics.md), e.g. "chip/cycles"
     std::string per;   ///< divide by this key ("image/pixels", "chip/instructions"), or empty
-    std::optional<double> max, min;   ///< at least one is given
+    std::optional<double> max, min;  ///< limits on the value
+    /// Limits on the value divided by the baseline kernel's (Assignment::baseline) on the same
+    /// scene and chip: 0.98 is 2 % less than the baseline. Budgets give at least one limit.
+    std::optional<double> max_ratio, min_ratio;
     std::vector<std::string> scenes;  ///< scene names it applies to; empty: every scene
     std::string hint;                 ///< what a failure likely means
     bool applies_to(std::string_view scene) const;
@@ -35,6 +38,9 @@ struct ImageThresholds {
     double min_psnr = 30;      ///< dB over every channel of the 8-bit sRGB images
     int tolerance = 4;         ///< a pixel differs when a channel is off by more than this /255
     double max_differing = 0;  ///< share of pixels allowed to differ
+    /// Compare the images' averages over blocks of block x block pixels (in linear light)
+    /// rather than single pixels: Monte Carlo noise averages away, a wrong light level does not.
+    int block = 1;
 };
 
 /// Per-assignment explanations for the likely cause of a failed image.
@@ -53,6 +59,9 @@ struct Assignment {
     /// Instructions one pixel may take (the render's per-work-item limit); 0: tpsim's default.
     uint64_t max_pixel_instructions = 0;
     std::string slow_hint;  ///< what it means when a pixel exceeds max_pixel_instructions
+    /// One of tpsim's own kernels by name (as `render --kernel NAME`), rendered on the same scenes
+    /// and chip for the budgets with a ratio; empty when none has one.
+    std::string baseline;
     ImageThresholds image;
     ImageHints hints;
     std::vector<AssignmentScene> scenes;

@@ -4,9 +4,11 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <optional>
 
 #include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "sim/core/error.hpp"
 #include "sim/core/fault.hpp"
@@ -72,6 +74,29 @@ Rgb8 undone(const Rgb8& image, Mistake mistake) {
             d[0] = s[exchange ? 2 : 0];
             d[1] = s[1];
             d[2] = s[exchange ? 0 : 2];
+        }
+    return out;
+}
+
+/// The image with each block x block square (cut short at the right and bottom edges) replaced
+/// by its average in linear light, as the comparison sees it when [image] block > 1.
+Rgb8 block_averages(const Rgb8& image, int block) {
+    Rgb8 out = image;
+    for (int by = 0; by < image.height; by += block)
+        for (int bx = 0; bx < image.width; bx += block) {
+            const int ey = std::min(by + block, image.height);
+            const int ex = std::min(bx + block, image.width);
+            for (int c = 0; c < 3; ++c) {
+                float sum = 0;
+                for (int y = by; y < ey; ++y)
+                    for (int x = bx; x < ex; ++x)
+                        sum += render::decode_srgb(
+                            image.pixels[(size_t(y) * image.width + x) * 3 + c]);
+                const uint8_t mean = render::encode_srgb(sum / float((ey - by) * (ex - bx)));
+                for (int y = by; y < ey; ++y)
+                    for (int x = bx; x < ex; ++x)
+                        out.pixels[(size_t(y) * image.width + x) * 3 + c] = mean;
+            }
         }
     return out;
 }
@@ -160,39 +185,88 @@ render::RenderOptions render_options(const Assignment& a, const AssignmentScene&
     return r;
 }
 
-/// The budgets of one scene, checked against its statistics.
-void check_budgets(const Assignment& a, const AssignmentScene& scene,
-                   const render::RenderResult& result, std::vector<CheckResult>& results) {
-    stats::Registry registry;
-    render::register_stats(result, registry);
-    const stats::Snapshot snapshot(registry);
-    const auto value = [&](const std::string& key) {
+/// A render's statistics, for budgets.
+class Statistics {
+public:
+    Statistics(const Assignment& a, const render::RenderResult& result) : a_(a) {
+        stats::Registry registry;
+        render::register_stats(result, registry);
+        snapshot_ = stats::Snapshot(registry);
+    }
+
+    /// The budget's statistic, divided by its `per` statistic when it has one.
+    double of(const Budget& b) const {
+        const double divisor = b.per.empty() ? 1.0 : value(b.per);
+        return divisor > 0 ? value(b.stat) / divisor : 0.0;
+    }
+
+private:
+    double value(const std::string& key) const {
         try {
-            return snapshot.value(key);
+            return snapshot_.value(key);
         } catch (const std::out_of_range&) {
             throw Error(fmt::format("{}: budget statistic '{}' is not a statistic of this render; "
                                     "see docs/statistics.md for the keys",
-                                    (a.dir / "assignment.toml").string(), key));
+                                    (a_.dir / "assignment.toml").string(), key));
         }
-    };
+    }
+
+    const Assignment& a_;
+    stats::Snapshot snapshot_;
+};
+
+/// "(3.1% over)" or "(2.1x over)": how far a measurement is beyond its limit.
+std::string over_by(double measured, double limit) {
+    return measured < 2 * limit ? fmt::format("{:.1f}% over", 100 * (measured / limit - 1))
+                                : fmt::format("{:.1f}x over", measured / limit);
+}
+
+bool needs_baseline(const Assignment& a, const AssignmentScene& scene) {
+    return std::any_of(a.budgets.begin(), a.budgets.end(), [&](const Budget& b) {
+        return b.applies_to(scene.name) && (b.max_ratio || b.min_ratio);
+    });
+}
+
+/// The budgets of one scene, checked against its statistics (and the baseline kernel's, for the
+/// budgets with a ratio).
+void check_budgets(const Assignment& a, const AssignmentScene& scene,
+                   const render::RenderResult& result, const render::RenderResult* baseline,
+                   std::vector<CheckResult>& results) {
+    const Statistics kernel(a, result);
+    std::optional<Statistics> base;
+    if (baseline) base.emplace(a, *baseline);
     for (const Budget& b : a.budgets) {
         if (!b.applies_to(scene.name)) continue;
-        const double divisor = b.per.empty() ? 1.0 : value(b.per);
-        const double measured = divisor > 0 ? value(b.stat) / divisor : 0.0;
-        const bool over = b.max && measured > *b.max, under = b.min && measured < *b.min;
-        CheckResult r{scene.name, "budget", !over && !under, ""};
-        if (over)
-            r.detail = fmt::format(
-                "{} {} > {} allowed ({} over)", b.label(), number(measured), number(*b.max),
-                measured < 2 * *b.max ? fmt::format("{:.1f}%", 100 * (measured / *b.max - 1))
-                                      : fmt::format("{:.1f}x", measured / *b.max));
-        else if (under)
-            r.detail =
-                fmt::format("{} {} < {} required", b.label(), number(measured), number(*b.min));
-        else
-            r.detail = fmt::format("{} {}{}{}", b.label(), number(measured),
-                                   b.min ? " >= " + number(*b.min) : "",
-                                   b.max ? " <= " + number(*b.max) : "");
+        const double measured = kernel.of(b);
+        std::vector<std::string> broken, kept;
+        if (b.max && measured > *b.max)
+            broken.push_back(
+                fmt::format("> {} allowed ({})", number(*b.max), over_by(measured, *b.max)));
+        else if (b.min && measured < *b.min)
+            broken.push_back(fmt::format("< {} required", number(*b.min)));
+        else {
+            if (b.min) kept.push_back(">= " + number(*b.min));
+            if (b.max) kept.push_back("<= " + number(*b.max));
+        }
+        std::string relative;
+        if (b.max_ratio || b.min_ratio) {
+            const double reference = base->of(b);
+            const double ratio = reference > 0 ? measured / reference : 0.0;
+            relative =
+                fmt::format(" = {:.1f}% of {}'s {}", 100 * ratio, a.baseline, number(reference));
+            if (b.max_ratio && ratio > *b.max_ratio)
+                broken.push_back(fmt::format("> {:g}% allowed", 100 * *b.max_ratio));
+            else if (b.min_ratio && ratio < *b.min_ratio)
+                broken.push_back(fmt::format("< {:g}% required", 100 * *b.min_ratio));
+            else {
+                if (b.min_ratio) kept.push_back(fmt::format(">= {:g}%", 100 * *b.min_ratio));
+                if (b.max_ratio) kept.push_back(fmt::format("<= {:g}%", 100 * *b.max_ratio));
+            }
+        }
+        CheckResult r{scene.name, "budget", broken.empty(), ""};
+        const std::vector<std::string>& limits = broken.empty() ? kept : broken;
+        r.detail = fmt::format("{} {}{}{}{}", b.label(), number(measured), relative,
+                               limits.empty() ? "" : " ", fmt::join(limits, ", "));
         if (!r.passed && !b.hint.empty()) r.detail += " — " + b.hint;
         results.push_back(std::move(r));
     }
@@ -201,6 +275,7 @@ void check_budgets(const Assignment& a, const AssignmentScene& scene,
 /// Bad input is found before the first (slow) render.
 void check_inputs(const Assignment& a, const CheckOptions& o) {
     render::Kernel::load(o.kernel);
+    if (!a.baseline.empty()) render::Kernel::load(o.baseline_kernel);
     if (o.update_references) return;
     for (const AssignmentScene& scene : a.scenes)
         if (!std::filesystem::is_regular_file(scene.reference))
@@ -273,13 +348,18 @@ CheckReport check(const Assignment& a, const CheckOptions& o) {
             report.results.push_back({scene.name, "image", true,
                                       fmt::format("reference written: {}", image_path.string())});
         } else {
-            const Rgb8 image = read_rgb8(image_path, "the kernel's image");
-            const Rgb8 ref = read_rgb8(scene.reference, "reference image");
+            Rgb8 image = read_rgb8(image_path, "the kernel's image");
+            Rgb8 ref = read_rgb8(scene.reference, "reference image");
             if (ref.width != image.width || ref.height != image.height)
                 throw Error(fmt::format("reference image {} is {}x{} but the assignment renders "
                                         "{}x{}; render it again with --update-references",
                                         scene.reference.string(), ref.width, ref.height,
                                         image.width, image.height));
+            const int block = a.image.block;
+            if (block > 1) {
+                image = block_averages(image, block);
+                ref = block_averages(ref, block);
+            }
             const ImageComparison c = compare_rgb8(image.pixels, ref.pixels, a.image.tolerance);
             CheckResult r{scene.name, "image", within(c, a.image), ""};
             const std::string psnr =
@@ -287,16 +367,24 @@ CheckReport check(const Assignment& a, const CheckOptions& o) {
                     ? "identical to the reference"
                     : fmt::format("PSNR {:.1f} dB {} {:g} dB required", c.psnr,
                                   c.psnr >= a.image.min_psnr ? ">=" : "<", a.image.min_psnr);
-            r.detail = fmt::format("{}; {} of pixels differ by more than {}/255 ({} allowed)", psnr,
-                                   percent(c.differing_share), a.image.tolerance,
-                                   percent(a.image.max_differing));
+            r.detail = fmt::format(
+                "{}{}; {} of pixels differ by more than {}/255 ({} allowed)",
+                block > 1 ? fmt::format("{}x{}-pixel averages: ", block, block) : "", psnr,
+                percent(c.differing_share), a.image.tolerance, percent(a.image.max_differing));
             if (!r.passed) r.detail += " — " + likely_cause(image, ref, c, a);
             report.results.push_back(std::move(r));
             const std::filesystem::path diff = o.output_dir / (stem + ".diff.png");
             write_rgb8(diff, difference_image(image, ref, a.image.tolerance));
             report.files.push_back(diff);
         }
-        check_budgets(a, scene, result, report.results);
+        std::optional<render::RenderResult> baseline;
+        if (needs_baseline(a, scene)) {
+            if (o.on_baseline) o.on_baseline(scene);
+            render::RenderOptions options = render_options(a, scene, o);
+            options.kernel = o.baseline_kernel;
+            baseline = render::render(options);
+        }
+        check_budgets(a, scene, result, baseline ? &*baseline : nullptr, report.results);
     }
     return report;
 }

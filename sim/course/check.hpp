@@ -21,13 +21,17 @@ struct CheckResult {
 
 struct CheckOptions {
     std::filesystem::path kernel;
+    /// The ELF of the assignment's baseline kernel (Assignment::baseline), when it names one.
+    std::filesystem::path baseline_kernel;
     std::filesystem::path output_dir = ".";  ///< the kernel's images and the difference images
     /// Write the kernel's images as the assignment's references instead of comparing (for the
     /// instructor, with the reference solution).
     bool update_references = false;
     /// Called when a scene starts rendering (index from 0) ...
     std::function<void(size_t index, const AssignmentScene&)> on_scene;
-    /// ... and while it renders on the chip model.
+    /// ... when the baseline kernel starts rendering it (for budgets with a ratio) ...
+    std::function<void(const AssignmentScene&)> on_baseline;
+    /// ... and while either renders on the chip model.
     render::ProgressCallback on_progress;
 };
 
@@ -50,9 +54,9 @@ struct ImageComparison {
 ImageComparison compare_rgb8(const std::vector<uint8_t>& image, const std::vector<uint8_t>& ref,
                              int tolerance);
 
-/// Runs the whole check. Throws tpsim::Error for bad input (the kernel or a scene cannot be
-/// loaded, a reference is missing or unreadable), the kernel and the references before the
-/// first render; a kernel that faults or runs away fails.
+/// Runs the whole check. Throws tpsim::Error for bad input (the kernel, the baseline kernel or a
+/// scene cannot be loaded, a reference is missing or unreadable), the kernels and the references
+/// before the first render; a kernel that faults or runs away fails.
 CheckReport check(const Assignment& assignment, const CheckOptions& options);
 
 }  // namespace tpsim::course

@@ -22,7 +22,8 @@ bool is_float_format(std::string extension) {
            extension == ".tif" || extension == ".tiff";
 }
 
-/// The sRGB opto-electronic transfer function (IEC 61966-2-1), to 8 bits.
+}  // namespace
+
 uint8_t encode_srgb(float linear) {
     if (!(linear > 0.f)) return 0;  // also maps NaN to black
     if (linear >= 1.f) return 255;
@@ -31,7 +32,10 @@ uint8_t encode_srgb(float linear) {
     return uint8_t(std::lround(v * 255.f));
 }
 
-}  // namespace
+float decode_srgb(uint8_t value) {
+    const float v = float(value) / 255.f;
+    return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+}
 
 void check_image_path(const std::filesystem::path& path) {
     if (!OIIO::ImageOutput::create(path.string())) {

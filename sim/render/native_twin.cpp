@@ -16,6 +16,7 @@
 #include "kernel/kernel_output.hpp"
 #include "kernel/native_twin.h"
 #include "sim/core/error.hpp"
+#include "sim/core/fault.hpp"
 
 namespace tpsim::render {
 namespace {
@@ -80,6 +81,15 @@ trax::KernelOutput collect_output(const char* output, const uint32_t* lengths, u
     return trax::KernelOutput::from_parts(std::move(threads), limit, dropped);
 }
 
+/// A fault the twin found and reported (a write into the scene, a global register that does not
+/// exist, a deadlock ...), with what the kernel printed before it. (After a crash by a signal the
+/// output is lost with the child's memory: the twin hands it over only when it ends by itself.)
+core::KernelError twin_error(const char* error, size_t capacity, trax::KernelOutput printed) {
+    return core::KernelError(error[0] != '\0' ? std::string(error, strnlen(error, capacity))
+                                              : "the native twin failed without saying why",
+                             std::move(printed));
+}
+
 }  // namespace
 
 std::filesystem::path native_twin_of(const std::filesystem::path& kernel_elf) {
@@ -121,10 +131,11 @@ trax::KernelOutput run_native_twin(const std::filesystem::path& library,
                                         uint32_t(kOutputLimit),
                                         lengths.data(),
                                         &dropped};
-        if (run(&context) != 0)
-            throw Error(error[0] != '\0' ? std::string(error)
-                                         : "the native twin failed without saying why");
-        return collect_output(output.data(), lengths.data(), num_threads, kOutputLimit, dropped);
+        const int status = run(&context);
+        trax::KernelOutput printed =
+            collect_output(output.data(), lengths.data(), num_threads, kOutputLimit, dropped);
+        if (status != 0) throw twin_error(error, kErrorBytes, std::move(printed));
+        return printed;
     }
 
     // The twin is the student's code running on the host: a wild pointer or runaway recursion
@@ -164,11 +175,11 @@ trax::KernelOutput run_native_twin(const std::filesystem::path& library,
             "name the thread, pc and source line, or run the twin in gdb with --no-fork "
             "(docs/debugging.md)",
             library.filename().string(), describe_signal(WTERMSIG(status))));
-    if (WEXITSTATUS(status) != 0)
-        throw Error(error[0] != '\0' ? std::string(error, strnlen(error, kErrorBytes))
-                                     : "the native twin failed without saying why");
+    trax::KernelOutput printed =
+        collect_output(output, lengths, num_threads, kOutputLimit, *dropped);
+    if (WEXITSTATUS(status) != 0) throw twin_error(error, kErrorBytes, std::move(printed));
     std::memcpy(global_words.data(), words, image_bytes);
-    return collect_output(output, lengths, num_threads, kOutputLimit, *dropped);
+    return printed;
 }
 
 }  // namespace tpsim::render

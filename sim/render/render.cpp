@@ -7,6 +7,7 @@
 #include <fmt/ranges.h>
 
 #include "sim/core/error.hpp"
+#include "sim/core/fault.hpp"
 #include "sim/core/machine.hpp"
 #include "sim/core/stack_bound.hpp"
 #include "sim/render/native_twin.hpp"
@@ -161,12 +162,14 @@ RenderResult render(const RenderOptions& options) {
     }
     result.run_seconds = seconds_since(start);
     result.traversal = image::read_thread_stats(result.image.header, result.image.words.data());
-    if (result.traversal.stack_overflows > 0)
-        throw Error(fmt::format(
+    if (result.traversal.stack_overflows > 0) {
+        const std::string message = fmt::format(
             "the kernel's BVH traversal stack overflowed {} times: it holds {} entries but the BVH "
             "is {} levels deep; build the BVH with traversal_stack_entries <= the kernel's stack",
             result.traversal.stack_overflows, trax::layout::kTraversalStackEntries,
-            result.bvh ? result.bvh->max_depth : 0));
+            result.bvh ? result.bvh->max_depth : 0);
+        throw core::KernelError(message, std::move(result.output));
+    }
     result.rgb = image::read_framebuffer(result.image.header, result.image.words.data());
     return result;
 }
