@@ -523,6 +523,13 @@ Hit trace_to(const Accel& accel, const SurfacePoint& s, Vec3 target, RayStats& s
     return trace_segment<true>(accel, s, target, stats);
 }
 
+/// trace_to() with the closest hit instead, for the experiment that measures the difference: a
+/// function of its own as trace_to() is, so the two kernels make the same calls.
+template <class Accel>
+Hit trace_closest_to(const Accel& accel, const SurfacePoint& s, Vec3 target, RayStats& stats) {
+    return trace_segment<false>(accel, s, target, stats);
+}
+
 /// Lambert shading of the camera ray (origin, dir): ambient plus every point light facing the
 /// surface, with hard shadows (any-hit rays from the offset hit point) and 1/d^2 falloff when
 /// the scene asks for them. shade() below is this with the default policy.
@@ -554,7 +561,7 @@ template <RenderPolicy kPolicy, class Accel>
             RayStats shadow;
             const Hit blocker = kPolicy.any_hit_shadows
                                     ? trace_to(accel, surface, light_position, shadow)
-                                    : trace_segment<false>(accel, surface, light_position, shadow);
+                                    : trace_closest_to(accel, surface, light_position, shadow);
             totals.add(shadow, true);
             if (blocker.triangle >= 0) continue;
         }
@@ -568,36 +575,73 @@ Vec3 shade(const Shading& s, const Accel& accel, Vec3 origin, Vec3 dir, ThreadTo
     return shade_with<RenderPolicy{}>(s, accel, origin, dir, totals);
 }
 
-/// Integer hash (Wellons' "lowbias32"): decorrelated jitter that depends only on its input.
-inline uint32_t hash(uint32_t x) {
-    x ^= x >> 16;
-    x *= 0x7feb352du;
-    x ^= x >> 15;
-    x *= 0x846ca68bu;
-    x ^= x >> 16;
-    return x;
+/// shade_with() for another policy, a function of its own as shade() is for the default: the
+/// course experiments' variants then make the tracer's calls (inlining everything into the
+/// pixel loop instead saves 2-4 % of the instructions, which would be measured as the policy's).
+template <RenderPolicy kPolicy, class Accel>
+Vec3 shade_variant(const Shading& s, const Accel& accel, Vec3 origin, Vec3 dir,
+                   ThreadTotals& totals) {
+    return shade_with<kPolicy>(s, accel, origin, dir, totals);
 }
+
 /// Uniform in [0, 1), 24 bits: exactly representable, the same on both sides.
 inline float unit_float(uint32_t bits) {
     return static_cast<float>(bits >> 8) * (1.0f / 16777216.0f);
 }
 
+/// The camera rays of the image: the scene's pinhole camera (scene_layout.hpp Camera) and the
+/// image size, loaded once per thread. Every camera ray starts at `eye` and goes through a point
+/// of the image plane.
+struct CameraRays {
+    Vec3 eye, corner, right, down;
+    int width;
+    float fwidth, fheight;
+
+    static CameraRays from_scene() {
+        const int camera = trax_camera();
+        return {load_vec3(camera, kCameraEye),
+                load_vec3(camera, kCameraCorner),
+                load_vec3(camera, kCameraRight),
+                load_vec3(camera, kCameraDown),
+                trax_image_width(),
+                static_cast<float>(trax_image_width()),
+                static_cast<float>(trax_image_height())};
+    }
+
+    /// The direction through image point (x, y), in pixels from the top-left corner: pixel
+    /// (i, j) covers [i, i + 1) x [j, j + 1), its centre is (i + 0.5, j + 0.5).
+    Vec3 through(float x, float y) const {
+        return corner + right * (x / fwidth) + down * (y / fheight);
+    }
+
+    /// The direction of camera ray `sample` of `samples` through `pixel` (y * width + x): the
+    /// pixel centre for one sample, else a jitter hashed from pixel and sample only, so the
+    /// image does not depend on which thread renders the pixel.
+    [[gnu::always_inline]] Vec3 direction(int pixel, int sample, int samples) const {
+        float jx = 0.5f, jy = 0.5f;
+        if (samples > 1) {
+            const uint32_t key = 2u * static_cast<uint32_t>(pixel * samples + sample);
+            jx = unit_float(trax_hash(key));
+            jy = unit_float(trax_hash(key + 1u));
+        }
+        const float x = static_cast<float>(pixel % width), y = static_cast<float>(pixel / width);
+        // through(x + jx, y + jy) written out, the same floats: through() makes clang schedule
+        // two adds differently and moves the tracer's reference cycles (by 0.02 %).
+        return corner + right * ((x + jx) / fwidth) + down * ((y + jy) / fheight);
+    }
+};
+
 /// The whole render kernel: pixels handed out with atomicinc(0) in the policy's order; each gets
-/// samples_per_pixel camera rays (pixel centre for one sample, hashed jitter for more), shaded
-/// and averaged into the framebuffer as linear RGB; the thread's statistics record is written
-/// at the end. render_image() below is this with the default policy.
+/// samples_per_pixel camera rays (CameraRays::direction), shaded and averaged into the framebuffer
+/// as linear RGB; the thread's statistics record is written at the end. render_image() below is
+/// this with the default policy.
 template <RenderPolicy kPolicy, class Accel>
 [[gnu::always_inline]] inline void render_image_with(const Accel& accel) {
     const Shading s = Shading::from_scene();
     const int width = trax_image_width(), height = trax_image_height();
     const int samples = trax_samples_per_pixel();
-    const int camera = trax_camera();
-    const Vec3 eye = load_vec3(camera, kCameraEye);
-    const Vec3 corner = load_vec3(camera, kCameraCorner);
-    const Vec3 right = load_vec3(camera, kCameraRight);
-    const Vec3 down = load_vec3(camera, kCameraDown);
+    const CameraRays camera = CameraRays::from_scene();
     const int framebuffer = trax_framebuffer();
-    const float fwidth = static_cast<float>(width), fheight = static_cast<float>(height);
     ThreadTotals totals;
 
     const int items = work_items(width, height, kPolicy.order);
@@ -605,20 +649,13 @@ template <RenderPolicy kPolicy, class Accel>
         const int pixel = pixel_of(item, width, height, kPolicy.order);
         if constexpr (kPolicy.order != PixelOrder::scanlines)
             if (pixel < 0) continue;
-        const float x = static_cast<float>(pixel % width), y = static_cast<float>(pixel / width);
         Vec3 color{0.0f, 0.0f, 0.0f};
         for (int sample = 0; sample < samples; ++sample) {
-            float jx = 0.5f, jy = 0.5f;
-            if (samples > 1) {
-                const uint32_t key = 2u * static_cast<uint32_t>(pixel * samples + sample);
-                jx = unit_float(hash(key));
-                jy = unit_float(hash(key + 1u));
-            }
-            const Vec3 dir = corner + right * ((x + jx) / fwidth) + down * ((y + jy) / fheight);
+            const Vec3 dir = camera.direction(pixel, sample, samples);
             if constexpr (kPolicy == RenderPolicy{})
-                color = color + shade(s, accel, eye, dir, totals);
+                color = color + shade(s, accel, camera.eye, dir, totals);
             else
-                color = color + shade_with<kPolicy>(s, accel, eye, dir, totals);
+                color = color + shade_variant<kPolicy>(s, accel, camera.eye, dir, totals);
         }
         color = color * (1.0f / static_cast<float>(samples));
         const int out = framebuffer + pixel * kPixelWords;

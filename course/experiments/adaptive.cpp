@@ -26,25 +26,18 @@ float luma(Vec3 c) {
 void trax_main() {
     const BvhTraversal accel = BvhTraversal::from_scene();
     const Shading s = Shading::from_scene();
-    const int width = trax_image_width(), height = trax_image_height();
+    const CameraRays camera = CameraRays::from_scene();
+    const int pixels = trax_image_width() * trax_image_height();
     const int most = trax_samples_per_pixel();
     const int first = most < kFirstSamples ? most : kFirstSamples;
-    const int camera = trax_camera();
-    const Vec3 eye = load_vec3(camera, kCameraEye);
-    const Vec3 corner = load_vec3(camera, kCameraCorner);
-    const Vec3 right = load_vec3(camera, kCameraRight);
-    const Vec3 down = load_vec3(camera, kCameraDown);
     const int framebuffer = trax_framebuffer();
-    const float fwidth = static_cast<float>(width), fheight = static_cast<float>(height);
     ThreadTotals totals;
 
-    for (int pixel = atomicinc(0); pixel < width * height; pixel = atomicinc(0)) {
-        const float x = static_cast<float>(pixel % width), y = static_cast<float>(pixel / width);
-        const auto sample = [&](int i) {
-            const uint32_t key = 2u * static_cast<uint32_t>(pixel * most + i);
-            const float jx = unit_float(hash(key)), jy = unit_float(hash(key + 1u));
-            const Vec3 dir = corner + right * ((x + jx) / fwidth) + down * ((y + jy) / fheight);
-            return shade(s, accel, eye, dir, totals);
+    for (int pixel = atomicinc(0); pixel < pixels; pixel = atomicinc(0)) {
+        // Sample i of `most`, at the tracer's sample positions. Inlined into both loops, so
+        // each computes the pixel's position once rather than per sample.
+        const auto sample = [&](int i) __attribute__((always_inline)) {
+            return shade(s, accel, camera.eye, camera.direction(pixel, i, most), totals);
         };
         Vec3 color{0.0f, 0.0f, 0.0f};
         float darkest = 3.0e38f, brightest = -3.0e38f;

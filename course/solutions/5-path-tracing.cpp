@@ -137,13 +137,8 @@ void trax_main() {
     const uint32_t seed = trax_run_seed();
     const int width = trax_image_width(), height = trax_image_height();
     const int samples = trax_samples_per_pixel();
-    const int camera = trax_camera();
-    const Vec3 eye = load_vec3(camera, kCameraEye);
-    const Vec3 corner = load_vec3(camera, kCameraCorner);
-    const Vec3 right = load_vec3(camera, kCameraRight);
-    const Vec3 down = load_vec3(camera, kCameraDown);
+    const CameraRays camera = CameraRays::from_scene();
     const int framebuffer = trax_framebuffer();
-    const float fwidth = static_cast<float>(width), fheight = static_cast<float>(height);
     ThreadTotals totals;
 
     for (int pixel = atomicinc(0); pixel < width * height; pixel = atomicinc(0)) {
@@ -153,8 +148,8 @@ void trax_main() {
             // The pixel's own numbers, whichever thread renders it.
             trax_srand(trax_hash(trax_hash(uint32_t(pixel), uint32_t(sample)), seed));
             const float jx = trax_rand(), jy = trax_rand();
-            const Vec3 dir = corner + right * ((x + jx) / fwidth) + down * ((y + jy) / fheight);
-            color = color + trace_path(bvh, s, emitters, num_emitters, eye, dir, totals);
+            const Vec3 dir = camera.through(x + jx, y + jy);
+            color = color + trace_path(bvh, s, emitters, num_emitters, camera.eye, dir, totals);
         }
         color = color * (1.0f / static_cast<float>(samples));
         const int out = framebuffer + pixel * kPixelWords;

@@ -1,11 +1,11 @@
-// Assignment 6, reference solution: assignment 4's traversal with two changes, each measured
-// (docs/course/6-performance.md):
+// Assignment 6, reference solution: assignment 4's traversal (bvh_traversal.hpp) with two
+// changes, each measured (docs/course/6-performance.md):
 // - a leaner slab test: rt.hpp's slab_entry widens every axis's exit distance by its rounding
 //   bound; widening only the smallest exit gives the same result (rounding is monotonic, so
 //   min(a * s, b * s) = min(a, b) * s for s > 0) with 3 multiplies per box instead of 6;
 // - pixels in 8 x 8 tiles instead of scanlines, so rays running at the same time on a TM read
 //   the same BVH nodes and triangles and the L1 keeps serving them.
-#include "rt.hpp"
+#include "bvh_traversal.hpp"
 
 TRAX_USES_BVH;
 
@@ -30,73 +30,13 @@ using namespace trax::rt;
     return entry <= exit ? entry : t_far + 1.0f + trax_abs(t_far);
 }
 
-struct Bvh {
-    int nodes, triangles;
-
-    template <bool kAnyHit> Hit trace(Vec3 origin, Vec3 dir, float t_max, RayStats& stats) const {
-        Hit hit;
-        hit.t = t_max;
-        const ShearedRay ray = shear(origin, dir);
-        const Vec3 inverse{1.0f / dir.x, 1.0f / dir.y, 1.0f / dir.z};
-        int stack[kTraversalStackEntries];
-        float entry[kTraversalStackEntries];
-        int depth = 0;
-        int node = nodes;
-        ++stats.nodes_visited;
-        if (box_entry(node, origin, inverse, hit.t) > hit.t) return hit;
-        for (;;) {
-            const int first = loadi(node, kNodeFirst), count = loadi(node, kNodeCount);
-            if (count == 0) {
-                // Interior: test both children's boxes, go into the nearer, keep the farther.
-                const int left = nodes + first * kBvhNodeWords, right = left + kBvhNodeWords;
-                stats.nodes_visited += 2;
-                const float t_left = box_entry(left, origin, inverse, hit.t);
-                const float t_right = box_entry(right, origin, inverse, hit.t);
-                const bool in_left = t_left <= hit.t, in_right = t_right <= hit.t;
-                if (in_left && in_right) {
-                    const bool left_nearer = t_left <= t_right;
-                    node = left_nearer ? left : right;
-                    stack[depth] = left_nearer ? right : left;
-                    entry[depth] = left_nearer ? t_right : t_left;
-                    ++depth;
-                    continue;
-                }
-                if (in_left || in_right) {
-                    node = in_left ? left : right;
-                    continue;
-                }
-            } else {
-                for (int i = first; i < first + count; ++i) {
-                    ++stats.triangles_tested;
-                    TriangleHit found;
-                    if (intersect(ray, triangles + i * kTriangleWords, hit.t, found)) {
-                        hit.triangle = i;
-                        hit.t = found.t;
-                        hit.plane_error = found.plane_error;
-                        if (kAnyHit) return hit;
-                    }
-                }
-            }
-            // Early-out: a subtree whose box starts beyond the closest hit cannot hold a closer
-            // one.
-            do {
-                if (depth == 0) return hit;
-                --depth;
-            } while (entry[depth] > hit.t);
-            node = stack[depth];
-        }
-    }
-};
-
 constexpr int kTile = 8;
 
 void trax_main() {
-    const Bvh bvh{trax_bvh(), trax_triangles()};
+    const SolutionBvh<box_entry> bvh = SolutionBvh<box_entry>::from_scene();
     const Shading s = Shading::from_scene();
     const int width = trax_image_width(), height = trax_image_height();
-    const int camera = trax_camera();
-    const Vec3 eye = load_vec3(camera, kCameraEye), corner = load_vec3(camera, kCameraCorner);
-    const Vec3 right = load_vec3(camera, kCameraRight), down = load_vec3(camera, kCameraDown);
+    const CameraRays camera = CameraRays::from_scene();
     const int framebuffer = trax_framebuffer();
     const int tiles_x = (width + kTile - 1) / kTile, tiles_y = (height + kTile - 1) / kTile;
     const int work = tiles_x * tiles_y * kTile * kTile;
@@ -106,9 +46,8 @@ void trax_main() {
         const int x = tile % tiles_x * kTile + in_tile % kTile;
         const int y = tile / tiles_x * kTile + in_tile / kTile;
         if (x >= width || y >= height) continue;  // the edge tiles of an odd-sized image
-        const Vec3 dir = corner + right * ((static_cast<float>(x) + 0.5f) / float(width)) +
-                         down * ((static_cast<float>(y) + 0.5f) / float(height));
-        const Vec3 c = shade(s, bvh, eye, dir, totals);
+        const Vec3 dir = camera.through(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f);
+        const Vec3 c = shade(s, bvh, camera.eye, dir, totals);
         const int out = framebuffer + (y * width + x) * kPixelWords;
         storef(c.x, out, 0);
         storef(c.y, out, 1);

@@ -225,7 +225,7 @@ std::string innermost_scopes(std::string_view function) {
 }
 
 void print_table_head(std::ostream& out, const std::string& what) {
-    fmt::print(out, " share cycles  execs fet brn  fu mem opd L1miss    DRAM  {}\n", what);
+    fmt::print(out, " share cycles  execs fet brn  fu mem opd syn L1miss    DRAM  {}\n", what);
 }
 
 }  // namespace
@@ -235,7 +235,7 @@ void print_profile(const Profile& p, std::ostream& out) {
     fmt::print(out,
                "profile  {} TP-cycles charged (issues + stalls), {} executions, {} L1 misses,\n"
                "         {} DRAM; stalls in % of the entry's cycles: fet fetch conflict,\n"
-               "         brn branch, fu FU busy, mem memory port, opd operand\n",
+               "         brn branch, fu FU busy, mem memory port, opd operand, syn sync\n",
                total, p.total.executions, p.total.l1_misses, compact_bytes(p.total.dram_bytes));
     print_table_head(out,
                      fmt::format("function (top {} of {})",

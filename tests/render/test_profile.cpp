@@ -253,7 +253,14 @@ TEST_CASE("profile: the report section names the hottest entries in 100 columns"
     // A head of three lines, two table heads, 10 functions (or all) and 15 lines.
     CHECK(rows == 3 + 2 + std::min<size_t>(10, p.functions.size()) + 15);
     CHECK(text.find(std::to_string(p.total.cycles)) != std::string::npos);
-    CHECK(text.find(render::short_function_name(p.functions[0].function)) != std::string::npos);
+    const std::string name = render::short_function_name(p.functions[0].function);
+    CHECK(text.find(name) != std::string::npos);
+    // The head names every column: its "function" stands above the rows' names, one stall
+    // column per cause between them.
+    const size_t head = text.find("function (top");
+    const size_t line_start = text.rfind('\n', head) + 1;
+    const size_t row_start = text.find('\n', head) + 1;
+    CHECK(head - line_start == text.find(name, row_start) - row_start);
     const std::string hottest_line = p.lines[0].file + ":" + std::to_string(p.lines[0].line) + " ";
     CHECK(text.find(hottest_line) != std::string::npos);
 }

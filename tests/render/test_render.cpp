@@ -144,4 +144,9 @@ TEST_CASE("render: the adaptive super-sampling kernel renders like its twin", "[
     const render::RenderResult adaptive = check_twin("cornell.toml", "adaptive.elf");
     // One sample per pixel in the scene: every pixel takes it, none is refined.
     CHECK(adaptive.traversal.primary_rays == 64 * 64);
+    // Its samples are the tracer's (CameraRays::direction): one sample is the tracer's image.
+    render::RenderOptions tracer =
+        small_options("cornell.toml", "tracer.elf", render::Engine::functional);
+    tracer.image_width = tracer.image_height = 64;
+    CHECK(first_difference(render::render(tracer).rgb, adaptive.rgb) == -1);
 }

@@ -64,13 +64,8 @@ void trax_main() {
     const uint32_t seed = trax_run_seed();
     const int width = trax_image_width(), height = trax_image_height();
     const int samples = trax_samples_per_pixel();
-    const int camera = trax_camera();
-    const Vec3 eye = load_vec3(camera, kCameraEye);
-    const Vec3 corner = load_vec3(camera, kCameraCorner);
-    const Vec3 right = load_vec3(camera, kCameraRight);
-    const Vec3 down = load_vec3(camera, kCameraDown);
+    const CameraRays camera = CameraRays::from_scene();
     const int framebuffer = trax_framebuffer();
-    const float fwidth = static_cast<float>(width), fheight = static_cast<float>(height);
     ThreadTotals totals;
 
     for (int pixel = atomicinc(0); pixel < width * height; pixel = atomicinc(0)) {
@@ -81,8 +76,8 @@ void trax_main() {
             // which pixel, and the simulator and the native twin agree bit for bit.
             trax_srand(trax_hash(trax_hash(uint32_t(pixel), uint32_t(sample)), seed));
             const float jx = trax_rand(), jy = trax_rand();
-            const Vec3 dir = corner + right * ((x + jx) / fwidth) + down * ((y + jy) / fheight);
-            color = color + trace_path(bvh, s, eye, dir, totals);
+            const Vec3 dir = camera.through(x + jx, y + jy);
+            color = color + trace_path(bvh, s, camera.eye, dir, totals);
         }
         color = color * (1.0f / static_cast<float>(samples));
         const int out = framebuffer + pixel * kPixelWords;
