@@ -46,6 +46,10 @@ void check_output_path(const std::filesystem::path& path, const std::string& wha
 void write_output(const std::filesystem::path& path, const std::string& text,
                   const std::string& what);
 
+/// A kernel given by name is one of the built kernels (build/kernels/NAME.elf); anything with a
+/// slash or ".elf" is a path. Throws tpsim::Error when no built kernel has the name.
+std::filesystem::path resolve_kernel(const std::string& kernel);
+
 Command add_exec_command(CLI::App& app);
 Command add_render_command(CLI::App& app);
 Command add_compare_command(CLI::App& app);

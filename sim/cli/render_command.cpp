@@ -28,17 +28,6 @@
 namespace tpsim::cli {
 namespace {
 
-/// A kernel given by name is one of the built kernels; anything with a slash or ".elf" is a path.
-std::filesystem::path resolve_kernel(const std::string& kernel) {
-    if (kernel.find('/') != std::string::npos || kernel.ends_with(".elf")) return kernel;
-    const std::filesystem::path built = std::filesystem::path(TPSIM_KERNEL_DIR) / (kernel + ".elf");
-    if (!std::filesystem::exists(built))
-        throw Error(fmt::format("no built kernel named '{}' (looked for {}); give a path to an ELF "
-                                "or build the kernel's NAME_elf target",
-                                kernel, built.string()));
-    return built;
-}
-
 /// What the kernel printed, after the summary, and once a note if some was dropped.
 void print_kernel_output(const trax::KernelOutput& output) {
     if (output.empty()) return;
@@ -66,6 +55,7 @@ struct RenderCommandOptions {
     std::string up;
     std::string output;
     std::string kernel = "tracer";
+    std::vector<std::string> params;
     std::string config;
     std::vector<std::string> overrides;
     std::string bvh = "sweep";
@@ -104,6 +94,7 @@ int run_render(const RenderCommandOptions& o) {
         fmt::print(stderr, "tpsim: warning: {}\n", warning);
     };
     options.kernel = resolve_kernel(o.kernel);
+    options.params = o.params;
     options.engine = o.native              ? render::Engine::native
                      : o.timing == "cycle" ? render::Engine::timing
                                            : render::Engine::functional;
@@ -226,13 +217,20 @@ Command add_render_command(CLI::App& app) {
     command->add_option("-k,--kernel", o->kernel, "Built kernel name, or a path to a kernel ELF")
         ->capture_default_str();
     command
+        ->add_option("-p,--param", o->params,
+                     "Set one of the kernel's run-time parameters (TRAX_PARAM), e.g. --param "
+                     "threshold=0.02 with --kernel adaptive; repeat for more")
+        ->allow_extra_args(false);  // one NAME=VALUE each: a scene after it stays the scene
+    command
         ->add_option(
             "-c,--config", o->config,
             "Chip configuration TOML (e.g. configs/tiny.toml) [default: built-in, the same as "
             "configs/trax.toml]")
         ->check(CLI::ExistingFile);
-    command->add_option("-s,--set", o->overrides,
-                        "Override one chip configuration field, e.g. --set chip.num_tms=8");
+    command
+        ->add_option("-s,--set", o->overrides,
+                     "Override one chip configuration field, e.g. --set chip.num_tms=8")
+        ->allow_extra_args(false);
     command
         ->add_option("--bvh", o->bvh,
                      "BVH builder, used when the kernel traverses a BVH (TRAX_USES_BVH)")

@@ -217,8 +217,9 @@ void print_summary(const RenderOptions& options, const RenderResult& r, std::ost
                overridden(options.image_width | options.image_height), r.scene.samples_per_pixel,
                overridden(options.samples_per_pixel),
                has_extras ? fmt::format(", seed {}", options.seed) : "");
-    fmt::print(out, "kernel   {} on {} ({} TMs x {} TPs = {} threads)\n",
+    fmt::print(out, "kernel   {}{} on {} ({} TMs x {} TPs = {} threads)\n",
                display_path(options.kernel),
+               r.params.empty() ? "" : " (" + describe_params(r.params) + ")",
                options.engine == Engine::native   ? "the native twin"
                : options.engine == Engine::timing ? "the cycle-level chip model"
                                                   : "the functional simulator",
@@ -303,6 +304,11 @@ nlohmann::ordered_json stats_document(const RenderOptions& options, const Render
     run["height"] = r.scene.height;
     run["samples_per_pixel"] = r.scene.samples_per_pixel;
     run["seed"] = options.seed;
+    if (!r.params.empty()) {
+        nlohmann::ordered_json& params = run["params"];
+        for (const KernelParam& p : r.params)
+            params[p.name] = nlohmann::ordered_json::parse(p.text());
+    }
     run["threads"] = r.threads;
     run["image"] = relative(outputs.image);
     if (!outputs.heatmap.empty()) run["heatmap"] = relative(outputs.heatmap);
