@@ -39,6 +39,20 @@ inline const CLI::Validator kWholeNumber(
     },
     "COUNT");
 
+/// A whole number in [lo, hi] (image sizes, samples per pixel): the message says the limits.
+inline CLI::Validator whole_number_in(uint32_t lo, uint32_t hi) {
+    return CLI::Validator(
+        [lo, hi](std::string& value) -> std::string {
+            uint64_t number = 0;
+            const char* end = value.data() + value.size();
+            const auto [parsed_to, error] = std::from_chars(value.data(), end, number);
+            if (error == std::errc{} && parsed_to == end && number >= lo && number <= hi) return {};
+            return "must be a whole number in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                   "], got '" + value + "'";
+        },
+        std::to_string(lo) + ".." + std::to_string(hi));
+}
+
 /// Throws tpsim::Error unless a file can be created at `path` (its directory exists); `what`
 /// names the file in the message ("the report").
 void check_output_path(const std::filesystem::path& path, const std::string& what);
@@ -56,5 +70,6 @@ Command add_compare_command(CLI::App& app);
 Command add_report_command(CLI::App& app);
 Command add_check_command(CLI::App& app);
 Command add_new_kernel_command(CLI::App& app);
+Command add_converge_command(CLI::App& app);
 
 }  // namespace tpsim::cli

@@ -26,14 +26,6 @@ std::string_view engine_name(Engine engine) {
     return "";
 }
 
-/// A path as a person reads it: relative to the working directory when it lies below it.
-std::string display_path(const std::filesystem::path& path) {
-    std::error_code ec;
-    const std::filesystem::path relative = std::filesystem::proximate(path, ec);
-    return !ec && !relative.empty() && *relative.begin() != ".." ? relative.string()
-                                                                 : path.string();
-}
-
 /// "12.3 KiB": bytes in the largest binary unit that keeps the number >= 1.
 std::string bytes_text(double bytes) {
     const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB"};
@@ -55,6 +47,26 @@ std::string percent_text(double numerator, double denominator) {
 }
 
 }  // namespace
+
+std::string display_path(const std::filesystem::path& path) {
+    std::error_code ec;
+    const std::filesystem::path relative = std::filesystem::proximate(path, ec);
+    return !ec && !relative.empty() && *relative.begin() != ".." ? relative.string()
+                                                                 : path.string();
+}
+
+std::string describe_config(const timing::ChipConfig& chip) {
+    std::string changed;
+    const std::vector<timing::ConfigField> defaults = timing::config_fields({});
+    const std::vector<timing::ConfigField> fields = timing::config_fields(chip);
+    for (size_t i = 0; i < fields.size(); ++i)
+        if (fields[i].value != defaults[i].value)
+            changed += fmt::format("{}{}={}", changed.empty() ? "" : ", ", fields[i].key,
+                                   fields[i].is_bool ? (fields[i].value ? "true" : "false")
+                                                     : std::to_string(fields[i].value));
+    return changed.empty() ? "the defaults (configs/trax.toml)"
+                           : "the defaults (configs/trax.toml) except " + changed;
+}
 
 std::vector<std::string> region_names(const stats::Snapshot& snapshot) {
     std::vector<std::string> names;
@@ -224,17 +236,7 @@ void print_summary(const RenderOptions& options, const RenderResult& r, std::ost
                : options.engine == Engine::timing ? "the cycle-level chip model"
                                                   : "the functional simulator",
                options.chip.chip.num_tms, options.chip.chip.tps_per_tm, r.threads);
-    std::string changed;
-    const std::vector<timing::ConfigField> defaults = timing::config_fields({});
-    const std::vector<timing::ConfigField> fields = timing::config_fields(options.chip);
-    for (size_t i = 0; i < fields.size(); ++i)
-        if (fields[i].value != defaults[i].value)
-            changed += fmt::format("{}{}={}", changed.empty() ? "" : ", ", fields[i].key,
-                                   fields[i].is_bool ? (fields[i].value ? "true" : "false")
-                                                     : std::to_string(fields[i].value));
-    fmt::print(out, "config   {}\n",
-               changed.empty() ? "the defaults (configs/trax.toml)"
-                               : "the defaults (configs/trax.toml) except " + changed);
+    fmt::print(out, "config   {}\n", describe_config(options.chip));
     fmt::print(out,
                "memory   {:.1f} KiB ({:.1f} KiB read-only scene):", double(r.image.bytes()) / 1024,
                double(r.image.read_only_bytes()) / 1024);
