@@ -72,6 +72,7 @@ void check(const ConvergeOptions& o, ConvergeResult& result) {
     render::Kernel kernel = render::Kernel::load(o.base.kernel);
     kernel.set_params(o.base.params);
     result.params = kernel.params;
+    render::check_stack(kernel, render::Engine::timing, o.base.chip);
     if (o.thresholds.empty()) return;
 
     render::Kernel adaptive = render::Kernel::load(o.adaptive_kernel);
@@ -87,6 +88,7 @@ void check(const ConvergeOptions& o, ConvergeResult& result) {
             throw Error("each adaptive run sets the threshold itself: give the thresholds with "
                         "--adaptive, not --adaptive-param threshold=...");
     adaptive.set_params(o.adaptive_params);
+    render::check_stack(adaptive, render::Engine::timing, o.base.chip);
     for (const render::KernelParam& p : adaptive.params)
         if (p.name != "threshold") result.adaptive_params.push_back(p);
     // The adaptive kernel's own rule (kernel/kernels/adaptive.cpp): it takes first_samples
