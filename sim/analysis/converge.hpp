@@ -77,9 +77,9 @@ ConvergeResult converge(const ConvergeOptions& options,
 std::string converge_header(const ConvergeOptions& options, const ConvergeResult& result);
 std::string converge_row(const ConvergeRun& run);
 
-/// The result as a file (format "tpsim-converge", version 1; docs/error-vs-time.md); image
-/// paths relative to the directory of `json_path`. `tpsim report` and --html make the page from
-/// it.
+/// The result as a file (format "tpsim-converge", version 1; docs/error-vs-time.md), image paths
+/// relative to the directory of `json_path`; converge_page() (html_report.hpp) makes the page
+/// from it.
 nlohmann::ordered_json converge_document(const ConvergeOptions& options,
                                          const ConvergeResult& result,
                                          const std::filesystem::path& json_path);

@@ -104,16 +104,12 @@ int run_converge(const ConvergeCommandOptions& o) {
     options.adaptive_params = o.adaptive_params;
     const uint32_t largest = *std::max_element(o.spp.begin(), o.spp.end());
     options.adaptive_spp = o.adaptive_spp != 0 ? o.adaptive_spp : largest;
-    // 16 times the most samples a run takes: the reference's own noise then adds at most
-    // 1/16 to a run's squared error (0.26 dB of PSNR).
+    const uint32_t most =
+        options.thresholds.empty() ? largest : std::max(largest, options.adaptive_spp);
+    // 16 times the most samples a run takes: the reference's own noise then adds at most 1/16
+    // to a run's squared error (0.26 dB of PSNR).
     options.reference_spp =
-        o.reference_spp != 0
-            ? o.reference_spp
-            : std::min<uint32_t>(
-                  65536,
-                  std::max<uint32_t>(256, 16 * std::max(largest, options.thresholds.empty()
-                                                                     ? 0
-                                                                     : options.adaptive_spp)));
+        o.reference_spp != 0 ? o.reference_spp : std::clamp<uint32_t>(16 * most, 256, 65536);
 
     if (!std::filesystem::is_directory(o.output_dir, ec))
         throw Error(
