@@ -3,7 +3,8 @@
 //   1. every pixel takes `first_samples` camera rays and stores their mean; a pixel whose rays
 //      differ in brightness (Rec. 709 luma of linear RGB) by more than `threshold` is marked;
 //   2. an unmarked pixel whose mean differs from a 4-neighbour's by more than `threshold` is
-//      marked too: an edge or a shadow boundary that all of its first rays missed;
+//      marked too: an edge or a shadow boundary that all of its first rays missed (unless
+//      `neighbours` is 0);
 //   3. every marked pixel takes the rest of the scene's samples_per_pixel.
 // Flat regions get `first_samples`, edges the full count (`tpsim converge` measures what that
 // saves; docs/error-vs-time.md). The mark is the sign bit of the pixel's red value in the
@@ -24,6 +25,8 @@ TRAX_USES_BVH;
 TRAX_PARAM(float, threshold, 0.05f);
 /// Rays every pixel takes first (at least 1, at most samples_per_pixel).
 TRAX_PARAM(int, first_samples, 4);
+/// 0 leaves pass 2 out: only pixels whose own first rays differ are refined.
+TRAX_PARAM(int, neighbours, 1);
 
 namespace {
 
@@ -115,7 +118,8 @@ void trax_main() {
                     first < most && brightest - darkest > limit);
     }
 
-    if (first < most) {  // the same on every thread, so all of them meet at the barriers
+    // The conditions are the same on every thread, so all of them meet at the barriers.
+    if (first < most && neighbours != 0) {
         trax_barrier();
         for (int pixel = atomicinc(1); pixel < pixels; pixel = atomicinc(1)) {
             const Stored own = load_pixel(framebuffer, pixel);
@@ -129,6 +133,8 @@ void trax_main() {
                 (y > 0 && differs(pixel - width)) || (y + 1 < height && differs(pixel + width)))
                 store_pixel(framebuffer, pixel, own.mean, true);
         }
+    }
+    if (first < most) {
         trax_barrier();
         for (int pixel = atomicinc(2); pixel < pixels; pixel = atomicinc(2)) {
             const Stored own = load_pixel(framebuffer, pixel);

@@ -23,7 +23,7 @@ namespace tpsim::cli {
 namespace {
 
 /// The thresholds the adaptive runs take when --adaptive is not given (with the tracer).
-constexpr const char* kDefaultThresholds = "0.1,0.05,0.02";
+constexpr const char* kDefaultThresholds = "0.2,0.1,0.05,0.02";
 
 struct ConvergeCommandOptions {
     std::string scene;

@@ -197,6 +197,14 @@ TEST_CASE("render: the adaptive kernel refines where neighbours differ, too", "[
     CHECK(r.traversal.primary_rays > pixels);
     CHECK(r.traversal.primary_rays < pixels * 8);
     CHECK((r.traversal.primary_rays - pixels) % 7 == 0);
+    // Without the neighbour pass nothing is refined then.
+    CHECK(
+        adaptive(render::Engine::functional, {"threshold=0.05", "first_samples=1", "neighbours=0"})
+            .traversal.primary_rays == pixels);
+    // With 4 first samples, the pass only adds: the same pixels and more.
+    CHECK(adaptive(render::Engine::native, {"threshold=0.05", "neighbours=0"})
+              .traversal.primary_rays <
+          adaptive(render::Engine::native, {"threshold=0.05"}).traversal.primary_rays);
 }
 
 TEST_CASE("render: the adaptive kernel with no more samples than its first is the tracer",
