@@ -341,6 +341,36 @@ TRAX_INLINE int trax_num_emitters() {
     return loadi(trax::layout::kExtrasAddr, trax::layout::kExtrasEmitters + 1);
 }
 
+// Run-time parameters (docs/kernel-api.md, "Run-time parameters").
+namespace trax::detail {
+/// Whether TRAX_PARAM's type is spelt as tpsim reads it back from the symbol's name.
+constexpr bool is_param_type(const char* type) {
+    const auto same = [](const char* a, const char* b) {
+        while (*a != '\0' && *a == *b) {
+            ++a;
+            ++b;
+        }
+        return *a == *b;
+    };
+    return same(type, "float") || same(type, "int");
+}
+}  // namespace trax::detail
+
+/// A run-time parameter: `TRAX_PARAM(float, threshold, 0.05f);` at file scope, outside any
+/// namespace, declares `threshold`, read like a const variable: 0.05f unless the run sets it
+/// (`tpsim render --param threshold=0.02`). The type is float or int. The value is the global
+/// `trax_param_<type>_<name>` in the kernel's .data, which tpsim finds in the ELF's symbol table
+/// (the simulator) or with dlsym (the native twin) and writes before any thread starts, so every
+/// engine runs with the same value. Kept by the link script even when unused.
+#define TRAX_PARAM(type, name, default_value)                                                      \
+    static_assert(trax::detail::is_param_type(#type),                                              \
+                  "TRAX_PARAM: the type must be float or int");                                    \
+    extern "C" {                                                                                   \
+    __attribute__((used, visibility("default"), section(".data.trax_params")))                     \
+    type trax_param_##type##_##name = default_value;                                               \
+    }                                                                                              \
+    [[maybe_unused]] static const type& name = trax_param_##type##_##name
+
 // Random numbers: integer operations only, so both sides draw the same bits.
 /// A well-mixed 32-bit hash (lowbias32, C. Wellons' hash prospector): for seeds, e.g.
 /// trax_srand(trax_hash(trax_hash(pixel, sample), trax_run_seed())).

@@ -184,6 +184,25 @@ std::vector<SetupDifference> setup_differences(const std::vector<StatsFile>& run
             values.push_back(run_field(run, field));
         add_if_different(field, values);
     }
+    // Kernel parameters (run.params, from kernels that declare TRAX_PARAMs).
+    const auto params_of = [](const StatsFile& run) {
+        const auto found = run.run.find("params");
+        return found != run.run.end() && found->is_object() ? *found : Json::object();
+    };
+    std::vector<std::string> params;
+    for (const StatsFile& run : runs) {
+        const Json own = params_of(run);
+        for (const auto& [name, value] : own.items())
+            add_unique(params, name);
+    }
+    for (const std::string& name : params) {
+        std::vector<std::string> values;
+        for (const StatsFile& run : runs) {
+            const Json own = params_of(run);
+            values.push_back(own.contains(name) ? own[name].dump() : std::string(kAbsent));
+        }
+        add_if_different("param " + name, values);
+    }
     std::vector<std::string> keys;
     for (const StatsFile& run : runs)
         for (const auto& [key, value] : run.config)

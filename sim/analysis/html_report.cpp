@@ -61,18 +61,23 @@ std::string readable(double value) {
 
 /// One chart for the JSON blob; report_page.js draws it with Chart.js.
 struct Chart {
-    std::string type = "bar";  ///< "bar" (labels + values) or "line" ({x, y} points)
+    /// "bar" (labels + values), "line" ({x, y} points over cycles) or "scatter" ({x, y, label}
+    /// points, optionally joined: a dataset's "line")
+    std::string type = "bar";
     std::string title = "";
     std::string unit = "";  ///< the value axis title
     bool horizontal = false;
     bool percent = false;
     bool log = false;  ///< a logarithmic value axis
     bool tall = false;
+    std::string x_title = "";  ///< scatter: the x axis title
+    bool x_log = false;        ///< scatter: a logarithmic x axis
     Json labels = Json::array();
     Json datasets = Json::array();
 
-    void add(std::string label, Json data) {
-        datasets.push_back({{"label", std::move(label)}, {"data", std::move(data)}});
+    void add(std::string label, Json data, bool line = false) {
+        datasets.push_back(
+            {{"label", std::move(label)}, {"data", std::move(data)}, {"line", line}});
     }
     bool has_data() const {
         for (const Json& d : datasets)
@@ -83,9 +88,11 @@ struct Chart {
         return false;
     }
     Json to_json() const {
-        return {
-            {"type", type},       {"title", title}, {"unit", unit},     {"horizontal", horizontal},
-            {"percent", percent}, {"log", log},     {"labels", labels}, {"datasets", datasets}};
+        return {{"type", type},       {"title", title},
+                {"unit", unit},       {"horizontal", horizontal},
+                {"percent", percent}, {"log", log},
+                {"xTitle", x_title},  {"xLog", x_log},
+                {"labels", labels},   {"datasets", datasets}};
     }
 };
 
@@ -683,6 +690,94 @@ std::string comparison_page(const std::vector<StatsFile>& runs, const Comparison
         all.push_back(&run);
     host_line(page, all);
     return page.finish("tpsim comparison", chart_js);
+}
+
+std::string converge_page(const Json& doc, const std::filesystem::path& base,
+                          const std::string& chart_js) {
+    Page page;
+    const auto text = [](const Json& j, const char* key) {
+        const auto found = j.find(key);
+        return found == j.end() || found->is_null() ? std::string()
+               : found->is_string()                 ? found->get<std::string>()
+                                                    : found->dump();
+    };
+    const auto number = [](const Json& j, const char* key) {
+        const auto found = j.find(key);
+        return found != j.end() && found->is_number() ? std::optional(found->get<double>())
+                                                      : std::nullopt;
+    };
+    const auto kernel_line = [&](const char* kernel, const char* params) {
+        std::string line = std::filesystem::path(text(doc, kernel)).stem().string();
+        std::string list;
+        if (const auto found = doc.find(params); found != doc.end() && found->is_object())
+            for (const auto& [name, value] : found->items())
+                list += (list.empty() ? "" : ", ") + name + "=" + value.dump();
+        return line + (list.empty() ? "" : " (" + list + ")");
+    };
+    const Json& reference = doc["reference"];
+    const std::string scene = text(doc, "scene");
+    page.body << fmt::format(
+        "<h1>tpsim converge: {}</h1>\n<p class=\"sub\">{}x{} pixels &middot; kernel {} "
+        "&middot; seed {}{}</p>\n<p class=\"sub\">Each image against a {} spp reference from "
+        "the native twin (seed {}): RMSE and PSNR over the 8-bit sRGB images, peak 1. Frame "
+        "cycles from the cycle-level chip model.</p>\n",
+        escape(scene), text(doc, "width"), text(doc, "height"),
+        escape(kernel_line("kernel", "params")), text(doc, "seed"),
+        doc.contains("adaptive_kernel")
+            ? " &middot; adaptive kernel " +
+                  escape(kernel_line("adaptive_kernel", "adaptive_params"))
+            : "",
+        text(reference, "samples_per_pixel"), text(reference, "seed"));
+
+    Chart chart{.type = "scatter",
+                .title = "Image error against frame cycles",
+                .unit = "PSNR (dB)",
+                .tall = true,
+                .x_title = "frame cycles (log scale)",
+                .x_log = true};
+    Json uniform = Json::array(), adaptive = Json::array();
+    for (const Json& run : doc["runs"]) {
+        const auto cycles = number(run, "cycles"), psnr = number(run, "psnr");
+        if (!cycles || !psnr) continue;  // identical to the reference: no finite PSNR
+        (text(run, "kind") == "adaptive" ? adaptive : uniform)
+            .push_back({{"x", *cycles}, {"y", *psnr}, {"label", text(run, "label")}});
+    }
+    chart.add("uniform samples per pixel", uniform, true);
+    if (!adaptive.empty()) chart.add("adaptive (threshold)", adaptive, true);
+    page.chart(chart);
+
+    page.body << "<table><tr><th>run</th><th class=\"num\">samples/px</th><th class=\"num\">"
+                 "frame cycles</th><th class=\"num\">rays</th><th class=\"num\">RMSE</th>"
+                 "<th class=\"num\">PSNR</th><th class=\"num\">uniform PSNR at the same "
+                 "cycles</th><th class=\"num\">host s</th></tr>\n";
+    for (const Json& run : doc["runs"]) {
+        const bool is_adaptive = text(run, "kind") == "adaptive";
+        const auto cell = [](const std::string& value) {
+            return "<td class=\"num\">" + value + "</td>";
+        };
+        const auto db = [](std::optional<double> v) {
+            return v ? fmt::format("{:.2f} dB", *v) : std::string("-");
+        };
+        page.body << "<tr><td>" << escape(text(run, "label")) << "</td>"
+                  << cell(is_adaptive
+                              ? fmt::format("{:.2f} of {}",
+                                            number(run, "camera_rays_per_pixel").value_or(0),
+                                            text(run, "samples_per_pixel"))
+                              : text(run, "samples_per_pixel"))
+                  << cell(readable(number(run, "cycles").value_or(0)))
+                  << cell(readable(number(run, "rays").value_or(0)))
+                  << cell(fmt::format("{:.6f}", number(run, "rmse").value_or(0)))
+                  << cell(number(run, "psnr") ? db(number(run, "psnr")) : "identical")
+                  << cell(is_adaptive ? db(number(run, "uniform_psnr_at_same_cycles")) : "")
+                  << cell(fmt::format("{:.1f}", number(run, "host_seconds").value_or(0)))
+                  << "</tr>\n";
+    }
+    page.body << "</table>\n<h2>Images</h2>\n<div class=\"images\">\n"
+              << image_tag(base / text(reference, "image"), text(reference, "label"));
+    for (const Json& run : doc["runs"])
+        page.body << image_tag(base / text(run, "image"), text(run, "label"));
+    page.body << "</div>\n";
+    return page.finish("tpsim converge: " + scene, chart_js);
 }
 
 }  // namespace tpsim::analysis

@@ -1,6 +1,7 @@
 // `tpsim report` and `tpsim compare --html`: one self-contained HTML page (images as base64
 // PNG, Chart.js inlined, all chart data in one JSON blob) that opens offline.
 #pragma once
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -19,5 +20,10 @@ std::string report_page(const StatsFile& run, const std::string& chart_js);
 /// The runs side by side, with grouped bar charts; `comparison` is compare(runs).
 std::string comparison_page(const std::vector<StatsFile>& runs, const Comparison& comparison,
                             const std::string& chart_js);
+
+/// The page of `tpsim converge` (its JSON document, converge.hpp): the chart of image error
+/// against frame cycles, the table and the images, read from files relative to `base`.
+std::string converge_page(const Json& document, const std::filesystem::path& base,
+                          const std::string& chart_js);
 
 }  // namespace tpsim::analysis

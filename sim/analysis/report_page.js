@@ -28,10 +28,16 @@
             return y !== null && y !== 0;
         });
     }
+    // Scatter charts (error against cycles) label their points: {x, y, label}.
+    function pointLabel(context) {
+        const raw = context.raw;
+        return (raw && raw.label ? raw.label + ': ' : '') + context.formattedValue;
+    }
     function options(spec) {
+        const scatter = spec.type === 'scatter';
         const valueAxis = {
             type: spec.log ? 'logarithmic' : 'linear',
-            beginAtZero: !spec.log,
+            beginAtZero: !spec.log && !scatter,
             title: { display: !!spec.unit, text: spec.unit },
             ticks: spec.percent ? { callback: function (v) { return v + ' %'; } } : {}
         };
@@ -40,6 +46,9 @@
             ? Math.max.apply(null, spec.datasets[0].data.map(function (p) { return p.x; })) : 0;
         const categoryAxis = spec.type === 'line'
             ? { type: 'linear', min: 0, max: lastCycle, title: { display: true, text: 'cycle' } }
+            : scatter
+            ? { type: spec.xLog ? 'logarithmic' : 'linear',
+                title: { display: true, text: spec.xTitle } }
             : { ticks: { autoSkip: false } };
         return {
             animation: false,
@@ -48,7 +57,8 @@
             indexAxis: spec.horizontal ? 'y' : 'x',
             plugins: {
                 title: { display: true, text: spec.title, font: { size: 14 } },
-                legend: { display: spec.datasets.length > 1 }
+                legend: { display: spec.datasets.length > 1 },
+                tooltip: scatter ? { callbacks: { label: pointLabel } } : {}
             },
             scales: spec.horizontal ? { x: valueAxis, y: categoryAxis }
                                     : { x: categoryAxis, y: valueAxis }
@@ -61,8 +71,9 @@
             const datasets = spec.datasets.map(function (d, k) {
                 const colour = palette[k % palette.length];
                 return { label: d.label, data: d.data, backgroundColor: colour,
-                         borderColor: colour, borderWidth: spec.type === 'line' ? 2 : 0,
-                         pointRadius: 0 };
+                         borderColor: colour, borderWidth: spec.type === 'bar' ? 0 : 2,
+                         pointRadius: spec.type === 'scatter' ? 4 : 0,
+                         showLine: spec.type !== 'scatter' || !!d.line };
             });
             new Chart(canvas, { type: spec.type, data: { labels: spec.labels, datasets: datasets },
                                 options: options(spec) });

@@ -1,6 +1,5 @@
 // `tpsim render SCENE`: renders a scene with a kernel on the simulated chip (or its native twin),
 // writes the image and prints the statistics.
-#include <charconv>
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
@@ -28,35 +27,12 @@
 namespace tpsim::cli {
 namespace {
 
-/// A kernel given by name is one of the built kernels; anything with a slash or ".elf" is a path.
-std::filesystem::path resolve_kernel(const std::string& kernel) {
-    if (kernel.find('/') != std::string::npos || kernel.ends_with(".elf")) return kernel;
-    const std::filesystem::path built = std::filesystem::path(TPSIM_KERNEL_DIR) / (kernel + ".elf");
-    if (!std::filesystem::exists(built))
-        throw Error(fmt::format("no built kernel named '{}' (looked for {}); give a path to an ELF "
-                                "or build the kernel's NAME_elf target",
-                                kernel, built.string()));
-    return built;
-}
-
-/// A whole number in [lo, hi], for the image overrides: the message says the limits.
-CLI::Validator whole_number_in(uint32_t lo, uint32_t hi) {
-    return CLI::Validator(
-        [lo, hi](std::string& value) -> std::string {
-            uint64_t number = 0;
-            const char* end = value.data() + value.size();
-            const auto [parsed_to, error] = std::from_chars(value.data(), end, number);
-            if (error == std::errc{} && parsed_to == end && number >= lo && number <= hi) return {};
-            return fmt::format("must be a whole number in [{}, {}], got '{}'", lo, hi, value);
-        },
-        fmt::format("{}..{}", lo, hi));
-}
-
 struct RenderCommandOptions {
     std::string scene;
     std::string up;
     std::string output;
     std::string kernel = "tracer";
+    std::vector<std::string> params;
     std::string config;
     std::vector<std::string> overrides;
     std::string bvh = "sweep";
@@ -97,6 +73,7 @@ int run_render(RenderCommandOptions& o) {
         fmt::print(stderr, "tpsim: warning: {}\n", warning);
     };
     options.kernel = resolve_kernel(o.kernel);
+    options.params = o.params;
     options.engine = o.native             ? render::Engine::native
                      : o.timing != "none" ? render::Engine::timing
                                           : render::Engine::functional;
@@ -229,13 +206,20 @@ Command add_render_command(CLI::App& app) {
     command->add_option("-k,--kernel", o->kernel, "Built kernel name, or a path to a kernel ELF")
         ->capture_default_str();
     command
+        ->add_option("-p,--param", o->params,
+                     "Set one of the kernel's run-time parameters (TRAX_PARAM), e.g. --param "
+                     "threshold=0.02 with --kernel adaptive; repeat for more")
+        ->allow_extra_args(false);  // one NAME=VALUE each: a scene after it stays the scene
+    command
         ->add_option(
             "-c,--config", o->config,
             "Chip configuration TOML (e.g. configs/tiny.toml) [default: built-in, the same as "
             "configs/trax.toml]")
         ->check(CLI::ExistingFile);
-    command->add_option("-s,--set", o->overrides,
-                        "Override one chip configuration field, e.g. --set chip.num_tms=8");
+    command
+        ->add_option("-s,--set", o->overrides,
+                     "Override one chip configuration field, e.g. --set chip.num_tms=8")
+        ->allow_extra_args(false);
     command
         ->add_option("--bvh", o->bvh,
                      "BVH builder, used when the kernel traverses a BVH (TRAX_USES_BVH)")

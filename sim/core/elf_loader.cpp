@@ -177,12 +177,12 @@ std::vector<Segment> read_segments(Elf* elf, const Elf32_Ehdr& eh, std::span<con
     return segments;
 }
 
-/// Function symbols and bare code labels that lie in executable segments.
-std::vector<Symbol> read_functions(Elf* elf, const std::vector<Segment>& segments) {
-    std::vector<Symbol> functions;
-    const auto in_code = [&](uint32_t a) {
-        return std::any_of(segments.begin(), segments.end(),
-                           [a](const Segment& s) { return s.executable && s.contains(a); });
+/// Function symbols and bare code labels that lie in executable segments (program.functions),
+/// and data objects that lie in writable ones (program.objects).
+void read_symbols(Elf* elf, Program& program) {
+    const auto in_segment = [&](uint32_t a, bool Segment::*kind) {
+        return std::any_of(program.segments.begin(), program.segments.end(),
+                           [&](const Segment& s) { return s.*kind && s.contains(a); });
     };
     for (Elf_Scn* scn = elf_nextscn(elf, nullptr); scn; scn = elf_nextscn(elf, scn)) {
         GElf_Shdr sh;
@@ -192,24 +192,30 @@ std::vector<Symbol> read_functions(Elf* elf, const std::vector<Segment>& segment
         const size_t count = data->d_size / sh.sh_entsize;
         for (size_t i = 0; i < count; ++i) {
             GElf_Sym sym;
-            if (!gelf_getsym(data, int(i), &sym)) continue;
+            if (!gelf_getsym(data, int(i), &sym) || sym.st_shndx == SHN_UNDEF) continue;
             const int type = GELF_ST_TYPE(sym.st_info);
-            if ((type != STT_FUNC && type != STT_NOTYPE) || sym.st_shndx == SHN_UNDEF) continue;
             const char* n = elf_strptr(elf, sh.sh_link, sym.st_name);
             // Skip unnamed symbols, local labels (.L*) and RISC-V mapping symbols ($x, $d).
             if (!n || !*n || n[0] == '.' || n[0] == '$') continue;
-            if (!in_code(uint32_t(sym.st_value))) continue;
-            functions.push_back({n, uint32_t(sym.st_value), uint32_t(sym.st_size)});
+            const Symbol symbol{n, uint32_t(sym.st_value), uint32_t(sym.st_size)};
+            if ((type == STT_FUNC || type == STT_NOTYPE) &&
+                in_segment(symbol.address, &Segment::executable))
+                program.functions.push_back(symbol);
+            else if (type == STT_OBJECT && in_segment(symbol.address, &Segment::writable))
+                program.objects.push_back(symbol);
         }
     }
     // Sized (typed) symbols first at equal addresses, so lookups prefer them; then by name for
     // a deterministic order.
-    std::sort(functions.begin(), functions.end(), [](const Symbol& a, const Symbol& b) {
-        if (a.address != b.address) return a.address < b.address;
-        if ((a.size != 0) != (b.size != 0)) return a.size != 0;
-        return a.name < b.name;
+    std::sort(program.functions.begin(), program.functions.end(),
+              [](const Symbol& a, const Symbol& b) {
+                  if (a.address != b.address) return a.address < b.address;
+                  if ((a.size != 0) != (b.size != 0)) return a.size != 0;
+                  return a.name < b.name;
+              });
+    std::sort(program.objects.begin(), program.objects.end(), [](const Symbol& a, const Symbol& b) {
+        return a.address != b.address ? a.address < b.address : a.name < b.name;
     });
-    return functions;
 }
 
 /// Reads .stack_sizes: (4-byte address, ULEB128 size) pairs. A damaged section is read up to
@@ -435,7 +441,7 @@ Program load_elf(std::span<const uint8_t> image, const std::string& name) {
     if (program.entry % 4 != 0)
         reject(name, fmt::format("entry point {:#010x} is not 4-byte aligned; align _start to 4",
                                  program.entry));
-    program.functions = read_functions(elf.get(), program.segments);
+    read_symbols(elf.get(), program);
     read_lines(elf.get(), program);
     program.frame_sizes = read_frame_sizes(elf.get());
     return program;

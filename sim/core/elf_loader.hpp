@@ -41,6 +41,7 @@ public:
     uint32_t entry = 0;
     std::vector<Segment> segments;  ///< sorted by vaddr, non-overlapping
     std::vector<Symbol> functions;  ///< sorted by address
+    std::vector<Symbol> objects;    ///< data objects in writable segments, sorted by address
 
     /// The function containing pc, or the nearest preceding unsized label; nullptr if none.
     const Symbol* function_at(uint32_t pc) const;

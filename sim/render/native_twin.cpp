@@ -98,7 +98,8 @@ std::filesystem::path native_twin_of(const std::filesystem::path& kernel_elf) {
 
 trax::KernelOutput run_native_twin(const std::filesystem::path& library,
                                    std::vector<uint32_t>& global_words, uint32_t num_threads,
-                                   uint32_t num_tms, uint32_t tm_size, TwinProcess process) {
+                                   uint32_t num_tms, uint32_t tm_size,
+                                   const std::vector<KernelParam>& params, TwinProcess process) {
     // RTLD_LOCAL keeps each twin's copy of the trax runtime to itself.
     const std::unique_ptr<void, int (*)(void*)> handle(
         dlopen(std::filesystem::absolute(library).c_str(), RTLD_NOW | RTLD_LOCAL), dlclose);
@@ -111,6 +112,15 @@ trax::KernelOutput run_native_twin(const std::filesystem::path& library,
     if (run == nullptr)
         throw Error(fmt::format("'{}' is not a tpsim native twin (no {} symbol)", library.string(),
                                 TPSIM_NATIVE_RUN_SYMBOL));
+    // Written before the child is forked, so it inherits them.
+    for (const KernelParam& param : params) {
+        void* value = dlsym(handle.get(), param.symbol().c_str());
+        if (value == nullptr)
+            throw Error(fmt::format("native twin '{}' has no parameter {} (symbol {}) though its "
+                                    "ELF has: rebuild the twin (target NAME_native)",
+                                    library.string(), param.name, param.symbol()));
+        std::memcpy(value, &param.bits, sizeof param.bits);
+    }
 
     constexpr uint64_t kOutputLimit = trax::KernelOutput::kDefaultLimitBytes;
     if (process == TwinProcess::in_process) {

@@ -46,7 +46,14 @@ InstructionCounts InstructionCounts::of(const core::Counters& counters) {
 }
 
 Kernel Kernel::load(const std::filesystem::path& elf) {
-    return {elf, core::load_elf(elf.string())};
+    Kernel kernel{elf, core::load_elf(elf.string()), {}};
+    kernel.params = kernel_params(kernel.program);
+    return kernel;
+}
+
+void Kernel::set_params(const std::vector<std::string>& assignments) {
+    render::set_params(params, assignments, elf.filename().string());
+    write_params(program, params);
 }
 
 bool Kernel::defines(std::string_view symbol_name) const {
@@ -80,7 +87,7 @@ KernelRun run_kernel(const Kernel& kernel, Engine engine, image::MemoryImage& im
         return {{},
                 run_native_twin(native_twin_of(kernel.elf), image.words,
                                 chip.chip.num_tms * chip.chip.tps_per_tm, chip.chip.num_tms,
-                                chip.chip.tps_per_tm, twin_process)};
+                                chip.chip.tps_per_tm, kernel.params, twin_process)};
     case Engine::timing: {
         TimingRunOptions watch;
         watch.max_instructions = max_instructions;
@@ -121,7 +128,9 @@ RenderResult render(const RenderOptions& options) {
     if (options.samples_per_pixel != 0) result.scene.samples_per_pixel = options.samples_per_pixel;
     result.load_seconds = seconds_since(start);
 
-    const Kernel kernel = Kernel::load(options.kernel);
+    Kernel kernel = Kernel::load(options.kernel);
+    kernel.set_params(options.params);
+    result.params = kernel.params;
     if (const std::string warning = check_stack(kernel, options.engine, options.chip);
         !warning.empty() && options.on_warning)
         options.on_warning(warning);

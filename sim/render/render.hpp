@@ -15,6 +15,7 @@
 #include "kernel/kernel_output.hpp"
 #include "sim/core/elf_loader.hpp"
 #include "sim/image/memory_image.hpp"
+#include "sim/render/kernel_params.hpp"
 #include "sim/render/native_twin.hpp"
 #include "sim/render/sampling.hpp"
 #include "sim/scene/bvh.hpp"
@@ -50,9 +51,14 @@ struct Profile;    // profile.hpp
 struct Kernel {
     std::filesystem::path elf;
     core::Program program;
+    /// The run-time parameters it declares (TRAX_PARAM), with the values every engine runs with.
+    std::vector<KernelParam> params;
 
     /// Throws tpsim::Error (one line) for an ELF tpsim cannot run.
     static Kernel load(const std::filesystem::path& elf);
+    /// Sets parameters from NAME=VALUE assignments (render --param) in the program and for the
+    /// twin. Throws tpsim::Error for an unknown name or a bad value (set_params).
+    void set_params(const std::vector<std::string>& assignments);
     /// Does the kernel traverse a BVH (define trax::layout::kUsesBvhSymbol)?
     bool uses_bvh() const;
     /// Does the kernel read the SceneExtras record (define trax::layout::kUsesExtrasSymbol)?
@@ -65,6 +71,9 @@ struct RenderOptions {
     std::filesystem::path scene;                   ///< scene file (.toml) or a bare mesh
     scene::UpAxis mesh_up = scene::UpAxis::pos_y;  ///< a bare mesh's up axis, turned to +y
     std::filesystem::path kernel;                  ///< kernel ELF; its twin is found next to it
+    /// The kernel's run-time parameters as NAME=VALUE (render --param); the rest keep their
+    /// defaults.
+    std::vector<std::string> params;
     Engine engine = Engine::functional;
     /// Engine::native: in a child process (a crash becomes an error) or in this one (gdb).
     TwinProcess twin_process = TwinProcess::child;
@@ -116,6 +125,7 @@ struct RenderResult {
     std::vector<float> rgb;              ///< framebuffer, linear RGB, row 0 at the top
     InstructionCounts instructions;      ///< zero for the native engine
     trax::KernelOutput output;           ///< what the kernel printed (trax_printf)
+    std::vector<KernelParam> params;     ///< the kernel's parameters as the run set them
     uint32_t threads = 0;
     std::shared_ptr<const TimingRun> timing;  ///< Engine::timing: the chip and its counters
     std::shared_ptr<const Profile> profile;   ///< RenderOptions::profile: by function and line

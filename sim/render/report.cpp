@@ -28,14 +28,6 @@ std::string_view engine_name(Engine engine) {
     return "";
 }
 
-/// A path as a person reads it: relative to the working directory when it lies below it.
-std::string display_path(const std::filesystem::path& path) {
-    std::error_code ec;
-    const std::filesystem::path relative = std::filesystem::proximate(path, ec);
-    return !ec && !relative.empty() && *relative.begin() != ".." ? relative.string()
-                                                                 : path.string();
-}
-
 /// "12.3 KiB": bytes in the largest binary unit that keeps the number >= 1.
 std::string bytes_text(double bytes) {
     const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB"};
@@ -57,6 +49,26 @@ std::string percent_text(double numerator, double denominator) {
 }
 
 }  // namespace
+
+std::string display_path(const std::filesystem::path& path) {
+    std::error_code ec;
+    const std::filesystem::path relative = std::filesystem::proximate(path, ec);
+    return !ec && !relative.empty() && *relative.begin() != ".." ? relative.string()
+                                                                 : path.string();
+}
+
+std::string describe_config(const timing::ChipConfig& chip) {
+    std::string changed;
+    const std::vector<timing::ConfigField> defaults = timing::config_fields({});
+    const std::vector<timing::ConfigField> fields = timing::config_fields(chip);
+    for (size_t i = 0; i < fields.size(); ++i)
+        if (fields[i].value != defaults[i].value)
+            changed += fmt::format("{}{}={}", changed.empty() ? "" : ", ", fields[i].key,
+                                   fields[i].is_bool ? (fields[i].value ? "true" : "false")
+                                                     : std::to_string(fields[i].value));
+    return changed.empty() ? "the defaults (configs/trax.toml)"
+                           : "the defaults (configs/trax.toml) except " + changed;
+}
 
 std::vector<std::string> region_names(const stats::Snapshot& snapshot) {
     std::vector<std::string> names;
@@ -268,23 +280,14 @@ void print_summary(const RenderOptions& options, const RenderResult& r,
                overridden(options.image_width | options.image_height), r.scene.samples_per_pixel,
                overridden(options.samples_per_pixel),
                has_extras ? fmt::format(", seed {}", options.seed) : "");
-    fmt::print(out, "kernel   {} on {} ({} TMs x {} TPs = {} threads)\n",
+    fmt::print(out, "kernel   {}{} on {} ({} TMs x {} TPs = {} threads)\n",
                display_path(options.kernel),
+               r.params.empty() ? "" : " (" + describe_params(r.params) + ")",
                options.engine == Engine::native   ? "the native twin"
                : options.engine == Engine::timing ? "the cycle-level chip model"
                                                   : "the functional simulator",
                options.chip.chip.num_tms, options.chip.chip.tps_per_tm, r.threads);
-    std::string changed;
-    const std::vector<timing::ConfigField> defaults = timing::config_fields({});
-    const std::vector<timing::ConfigField> fields = timing::config_fields(options.chip);
-    for (size_t i = 0; i < fields.size(); ++i)
-        if (fields[i].value != defaults[i].value)
-            changed += fmt::format("{}{}={}", changed.empty() ? "" : ", ", fields[i].key,
-                                   fields[i].is_bool ? (fields[i].value ? "true" : "false")
-                                                     : std::to_string(fields[i].value));
-    fmt::print(out, "config   {}\n",
-               changed.empty() ? "the defaults (configs/trax.toml)"
-                               : "the defaults (configs/trax.toml) except " + changed);
+    fmt::print(out, "config   {}\n", describe_config(options.chip));
     fmt::print(out,
                "memory   {:.1f} KiB ({:.1f} KiB read-only scene):", double(r.image.bytes()) / 1024,
                double(r.image.read_only_bytes()) / 1024);
@@ -360,6 +363,11 @@ nlohmann::ordered_json stats_document(const RenderOptions& options, const Render
     run["height"] = r.scene.height;
     run["samples_per_pixel"] = r.scene.samples_per_pixel;
     run["seed"] = options.seed;
+    if (!r.params.empty()) {
+        nlohmann::ordered_json& params = run["params"];
+        for (const KernelParam& p : r.params)
+            params[p.name] = nlohmann::ordered_json::parse(p.text());
+    }
     run["threads"] = r.threads;
     run["image"] = relative(outputs.image);
     if (!outputs.heatmap.empty()) run["heatmap"] = relative(outputs.heatmap);

@@ -29,6 +29,13 @@ struct RunStatistics {
 };
 RunStatistics run_statistics(const RenderResult& result);
 
+/// A path as a person reads it: relative to the working directory when it lies below it.
+std::string display_path(const std::filesystem::path& path);
+
+/// "the defaults (configs/trax.toml) except l1.size_bytes=16384": the chip configuration as the
+/// fields that differ from the defaults.
+std::string describe_config(const timing::ChipConfig& chip);
+
 /// The human summary the report leads with: scene, kernel and chip (the configuration fields
 /// that differ from the defaults), memory image by section, BVH, rays, cycles, run speed; for
 /// a sampled run, what was sampled and the key estimates with their intervals.

@@ -140,13 +140,80 @@ TEST_CASE("render: the course experiments' variants render the tracer's image at
     }
 }
 
-TEST_CASE("render: the adaptive super-sampling kernel renders like its twin", "[render]") {
-    const render::RenderResult adaptive = check_twin("cornell.toml", "adaptive.elf");
-    // One sample per pixel in the scene: every pixel takes it, none is refined.
-    CHECK(adaptive.traversal.primary_rays == 64 * 64);
-    // Its samples are the tracer's (CameraRays::direction): one sample is the tracer's image.
-    render::RenderOptions tracer =
-        small_options("cornell.toml", "tracer.elf", render::Engine::functional);
-    tracer.image_width = tracer.image_height = 64;
-    CHECK(first_difference(render::render(tracer).rgb, adaptive.rgb) == -1);
+namespace {
+
+/// The Cornell box at 24 x 16 (edges, shadow boundaries and flat walls), 8 samples per pixel.
+render::RenderResult adaptive(render::Engine engine, std::vector<std::string> params,
+                              const char* kernel = "adaptive.elf") {
+    render::RenderOptions o = small_options("cornell.toml", kernel, engine);
+    o.image_width = 24;
+    o.image_height = 16;
+    o.samples_per_pixel = 8;
+    o.params = std::move(params);
+    return render::render(o);
+}
+
+}  // namespace
+
+TEST_CASE("render: the adaptive kernel renders the same image on every engine", "[render]") {
+    for (const char* threshold : {"threshold=0.05", "threshold=0.005"}) {
+        INFO(threshold);
+        const render::RenderResult functional = adaptive(render::Engine::functional, {threshold});
+        CHECK(first_difference(functional.rgb, adaptive(render::Engine::native, {threshold}).rgb) ==
+              -1);
+        CHECK(first_difference(functional.rgb, adaptive(render::Engine::timing, {threshold}).rgb) ==
+              -1);
+    }
+}
+
+TEST_CASE("render: the adaptive kernel spends samples between its first ones and all of them",
+          "[render]") {
+    const uint64_t pixels = 24 * 16;
+    const render::RenderResult tracer = adaptive(render::Engine::native, {}, "tracer.elf");
+    // Below 0 every pixel is refined: the tracer's image at 8 spp, bit for bit (the same sample
+    // positions, summed in the same order).
+    const render::RenderResult all = adaptive(render::Engine::native, {"threshold=-1"});
+    CHECK(all.traversal.primary_rays == pixels * 8);
+    CHECK(first_difference(all.rgb, tracer.rgb) == -1);
+    // Above any difference none is: every pixel keeps its first samples.
+    const render::RenderResult none = adaptive(render::Engine::native, {"threshold=1e30"});
+    CHECK(none.traversal.primary_rays == pixels * 4);
+    CHECK(first_difference(none.rgb, tracer.rgb) != -1);
+    CHECK(adaptive(render::Engine::native, {"threshold=1e30", "first_samples=2"})
+              .traversal.primary_rays == pixels * 2);
+    // In between, some are: the edges, not the flat walls.
+    const render::RenderResult some = adaptive(render::Engine::native, {"threshold=0.05"});
+    CHECK(some.traversal.primary_rays > none.traversal.primary_rays);
+    CHECK(some.traversal.primary_rays < all.traversal.primary_rays);
+    CHECK((some.traversal.primary_rays - pixels * 4) % 4 == 0);  // 4 more for each refined
+}
+
+TEST_CASE("render: the adaptive kernel refines where neighbours differ, too", "[render]") {
+    // With one first sample a pixel's own samples never differ: every refined pixel was found
+    // by the neighbour pass.
+    const uint64_t pixels = 24 * 16;
+    const render::RenderResult r =
+        adaptive(render::Engine::functional, {"threshold=0.05", "first_samples=1"});
+    CHECK(r.traversal.primary_rays > pixels);
+    CHECK(r.traversal.primary_rays < pixels * 8);
+    CHECK((r.traversal.primary_rays - pixels) % 7 == 0);
+    // Without the neighbour pass nothing is refined then.
+    CHECK(
+        adaptive(render::Engine::functional, {"threshold=0.05", "first_samples=1", "neighbours=0"})
+            .traversal.primary_rays == pixels);
+    // With 4 first samples, the pass only adds: the same pixels and more.
+    CHECK(adaptive(render::Engine::native, {"threshold=0.05", "neighbours=0"})
+              .traversal.primary_rays <
+          adaptive(render::Engine::native, {"threshold=0.05"}).traversal.primary_rays);
+}
+
+TEST_CASE("render: the adaptive kernel with no more samples than its first is the tracer",
+          "[render]") {
+    // first_samples >= samples_per_pixel: one pass, the tracer's sample positions.
+    render::RenderOptions o = small_options("cornell.toml", "adaptive.elf", render::Engine::native);
+    o.image_width = o.image_height = 16;
+    o.samples_per_pixel = 3;
+    const render::RenderResult adaptive_image = render::render(o);
+    o.kernel = std::filesystem::path(TPSIM_KERNEL_DIR) / "tracer.elf";
+    CHECK(first_difference(adaptive_image.rgb, render::render(o).rgb) == -1);
 }
