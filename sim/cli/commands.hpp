@@ -39,6 +39,20 @@ inline const CLI::Validator kWholeNumber(
     },
     "COUNT");
 
+/// A whole number in [lo, hi] (image sizes, samples per pixel): the message says the limits.
+inline CLI::Validator whole_number_in(uint32_t lo, uint32_t hi) {
+    return CLI::Validator(
+        [lo, hi](std::string& value) -> std::string {
+            uint64_t number = 0;
+            const char* end = value.data() + value.size();
+            const auto [parsed_to, error] = std::from_chars(value.data(), end, number);
+            if (error == std::errc{} && parsed_to == end && number >= lo && number <= hi) return {};
+            return "must be a whole number in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                   "], got '" + value + "'";
+        },
+        std::to_string(lo) + ".." + std::to_string(hi));
+}
+
 /// Throws tpsim::Error unless a file can be created at `path` (its directory exists); `what`
 /// names the file in the message ("the report").
 void check_output_path(const std::filesystem::path& path, const std::string& what);
@@ -46,11 +60,16 @@ void check_output_path(const std::filesystem::path& path, const std::string& wha
 void write_output(const std::filesystem::path& path, const std::string& text,
                   const std::string& what);
 
+/// A kernel given by name is one of the built kernels (build/kernels/NAME.elf); anything with a
+/// slash or ".elf" is a path. Throws tpsim::Error when no built kernel has the name.
+std::filesystem::path resolve_kernel(const std::string& kernel);
+
 Command add_exec_command(CLI::App& app);
 Command add_render_command(CLI::App& app);
 Command add_compare_command(CLI::App& app);
 Command add_report_command(CLI::App& app);
 Command add_check_command(CLI::App& app);
 Command add_new_kernel_command(CLI::App& app);
+Command add_sample_check_command(CLI::App& app);
 
 }  // namespace tpsim::cli

@@ -1,6 +1,5 @@
 // `tpsim render SCENE`: renders a scene with a kernel on the simulated chip (or its native twin),
 // writes the image and prints the statistics.
-#include <charconv>
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
@@ -28,17 +27,6 @@
 namespace tpsim::cli {
 namespace {
 
-/// A kernel given by name is one of the built kernels; anything with a slash or ".elf" is a path.
-std::filesystem::path resolve_kernel(const std::string& kernel) {
-    if (kernel.find('/') != std::string::npos || kernel.ends_with(".elf")) return kernel;
-    const std::filesystem::path built = std::filesystem::path(TPSIM_KERNEL_DIR) / (kernel + ".elf");
-    if (!std::filesystem::exists(built))
-        throw Error(fmt::format("no built kernel named '{}' (looked for {}); give a path to an ELF "
-                                "or build the kernel's NAME_elf target",
-                                kernel, built.string()));
-    return built;
-}
-
 /// What the kernel printed, after the summary, and once a note if some was dropped.
 void print_kernel_output(const trax::KernelOutput& output) {
     if (output.empty()) return;
@@ -46,19 +34,6 @@ void print_kernel_output(const trax::KernelOutput& output) {
     std::fflush(stdout);  // before the note on stderr
     if (const std::string note = output.truncation_note(); !note.empty())
         fmt::print(stderr, "tpsim: warning: {}\n", note);
-}
-
-/// A whole number in [lo, hi], for the image overrides: the message says the limits.
-CLI::Validator whole_number_in(uint32_t lo, uint32_t hi) {
-    return CLI::Validator(
-        [lo, hi](std::string& value) -> std::string {
-            uint64_t number = 0;
-            const char* end = value.data() + value.size();
-            const auto [parsed_to, error] = std::from_chars(value.data(), end, number);
-            if (error == std::errc{} && parsed_to == end && number >= lo && number <= hi) return {};
-            return fmt::format("must be a whole number in [{}, {}], got '{}'", lo, hi, value);
-        },
-        fmt::format("{}..{}", lo, hi));
 }
 
 struct RenderCommandOptions {
