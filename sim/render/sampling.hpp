@@ -45,7 +45,8 @@ struct SamplingSummary {
 
 /// Runs the chip (fresh, over a machine source) to its end, sampled. `chip_stats` holds the
 /// chip's statistics (Chip::register_stats); `progress` is called now and then. Returns the
-/// units and the exactly measured remainder for stats::estimate (no units: summary.exact).
+/// units and the exactly measured remainder for stats::estimate (no units and summary.exact
+/// when the run ended within its head).
 stats::UnitSamples run_sampled(timing::Chip& chip, const stats::Registry& chip_stats,
                                const SamplingOptions& options, SamplingSummary& summary,
                                const std::function<void()>& progress);
