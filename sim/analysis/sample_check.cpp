@@ -66,7 +66,7 @@ double SampleCheckResult::cpu_seconds(double rate) const {
     std::vector<double> all;
     for (const SampledRun* run : at(rate))
         all.insert(all.end(), run->cpu_seconds.begin(), run->cpu_seconds.end());
-    return median(all);
+    return all.empty() ? std::nan("") : median(all);
 }
 
 Coverage SampleCheckResult::coverage(double rate, size_t statistic) const {

@@ -92,7 +92,7 @@ struct SampleCheckResult {
 
     /// The runs at `rate`.
     std::vector<const SampledRun*> at(double rate) const;
-    /// Median CPU seconds of every timing at `rate`.
+    /// Median CPU seconds of every timing at `rate`; NaN when every run there was refused.
     double cpu_seconds(double rate) const;
     /// Over the seeds at `rate` that gave an estimate.
     Coverage coverage(double rate, size_t statistic) const;
