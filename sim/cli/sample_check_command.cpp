@@ -1,6 +1,7 @@
 // `tpsim sample-check SCENE`: how accurate and how fast sampled simulation is on this scene and
 // chip: the full cycle-level run, the functional bound and sampled runs at several rates and
 // seeds, as a table, a JSON file and an HTML page.
+#include <charconv>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -17,6 +18,17 @@
 
 namespace tpsim::cli {
 namespace {
+
+/// A sampling rate: a number in (0, 1].
+const CLI::Validator kRate(
+    [](std::string& value) -> std::string {
+        double rate = 0;
+        const char* end = value.data() + value.size();
+        const auto [parsed_to, error] = std::from_chars(value.data(), end, rate);
+        if (error == std::errc{} && parsed_to == end && rate > 0 && rate <= 1) return {};
+        return "must be a number in (0, 1], got '" + value + "'";
+    },
+    "RATE");
 
 struct SampleCheckCommandOptions {
     std::string scene;
@@ -103,13 +115,13 @@ Command add_sample_check_command(CLI::App& app) {
                      "cycle), comma-separated")
         ->delimiter(',')
         ->allow_extra_args(false)
-        ->check(CLI::Range(0.0, 1.0))
+        ->check(kRate)
         ->default_str("0.005,0.01,0.02,0.05");
     command
         ->add_option("--seeds", o->check.seeds,
                      "Sampled runs per rate, with seeds 1..N: the share of their 95 % intervals "
                      "that contain the true value is the measured coverage")
-        ->check(kPositiveCount)
+        ->check(whole_number_in(1, 100000))
         ->capture_default_str();
     command
         ->add_option("--sample-unit", o->check.sampling.unit_cycles,
@@ -125,7 +137,7 @@ Command add_sample_check_command(CLI::App& app) {
         ->add_option("--repeat", o->check.repeat,
                      "Time the full run, the functional run and each rate's seed 1 this many "
                      "times, in interleaved rounds; host times are medians")
-        ->check(kPositiveCount)
+        ->check(whole_number_in(1, 1000))
         ->capture_default_str();
     command->add_option("--json", o->json, "Write the result as JSON here");
     command->add_option("--html", o->html,
