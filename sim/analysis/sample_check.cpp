@@ -119,6 +119,42 @@ void check_same(bool same, const std::string& what) {
                                 what));
 }
 
+/// One sampled render at `rate` and `seed`, checked against the full run's values and image.
+SampledRun sampled_run(const SampleCheckOptions& options, double rate, uint32_t seed,
+                       const std::vector<double>& truth, const std::vector<float>& full_image) {
+    render::RenderOptions sampled = options.base;
+    sampled.engine = render::Engine::timing;
+    sampled.sampling = options.sampling;
+    sampled.sampling->rate = rate;
+    sampled.sampling->seed = seed;
+    SampledRun run;
+    run.rate = rate;
+    run.seed = seed;
+    try {
+        const render::RenderResult r = render_timed(sampled);
+        const render::RunStatistics statistics = render::run_statistics(r);
+        const render::SamplingSummary& summary = *r.timing->sampling;
+        run.cpu_seconds.push_back(r.run_cpu_seconds);
+        run.exact = summary.exact;
+        run.units = summary.units;
+        run.cycle_level_share =
+            1 - double(summary.warmed_instructions) / double(r.instructions.total);
+        run.same_image = r.rgb == full_image;
+        const std::vector<double> estimates = values_of(statistics);
+        for (size_t s = 0; s < estimates.size(); ++s) {
+            const char* key = checked_statistics()[s].key;
+            run.checks.push_back({estimates[s],
+                                  statistics.estimate ? statistics.estimate->interval(key) : 0.0,
+                                  truth[s]});
+        }
+    } catch (const Error& e) {
+        // Too few units at this rate: a finding for the table, not a failure. A kernel fault
+        // would have stopped the full run already.
+        run.refused = e.what();
+    }
+    return run;
+}
+
 }  // namespace
 
 SampleCheckResult sample_check(const SampleCheckOptions& options) {
@@ -167,36 +203,7 @@ SampleCheckResult sample_check(const SampleCheckOptions& options) {
         for (double rate : rates)
             for (uint32_t seed = 1; seed <= (round == 0 ? options.seeds : 1); ++seed) {
                 announce(fmt::format("rate {}, seed {}", rate_text(rate), seed));
-                render::RenderOptions sampled = options.base;
-                sampled.engine = render::Engine::timing;
-                sampled.sampling = options.sampling;
-                sampled.sampling->rate = rate;
-                sampled.sampling->seed = seed;
-                SampledRun run;
-                run.rate = rate;
-                run.seed = seed;
-                try {
-                    const render::RenderResult r = render_timed(sampled);
-                    const render::RunStatistics statistics = render::run_statistics(r);
-                    const render::SamplingSummary& summary = *r.timing->sampling;
-                    run.cpu_seconds.push_back(r.run_cpu_seconds);
-                    run.exact = summary.exact;
-                    run.units = summary.units;
-                    run.cycle_level_share =
-                        1 - double(summary.warmed_instructions) / double(r.instructions.total);
-                    run.same_image = r.rgb == full_image;
-                    const std::vector<double> estimates = values_of(statistics);
-                    for (size_t s = 0; s < estimates.size(); ++s)
-                        run.checks.push_back({estimates[s],
-                                              statistics.estimate ? statistics.estimate->interval(
-                                                                        checked_statistics()[s].key)
-                                                                  : 0.0,
-                                              result.truth[s]});
-                } catch (const Error& e) {
-                    // Too few units at this rate: a finding for the table, not a failure. A
-                    // kernel fault would have stopped the full run already.
-                    run.refused = e.what();
-                }
+                SampledRun run = sampled_run(options, rate, seed, result.truth, full_image);
                 if (round == 0) {
                     result.runs.push_back(std::move(run));
                     continue;
@@ -273,10 +280,11 @@ std::string sample_check_table(const SampleCheckOptions& o, const SampleCheckRes
                        count_text(double(o.sampling.unit_cycles)),
                        count_text(double(o.sampling.warmup_cycles)),
                        o.seeds == 1 ? "1" : fmt::format("1-{}", o.seeds));
-    out << fmt::format("host time  CPU seconds of the kernel run, median of {} (full and "
-                       "functional runs) and of {} or more (each rate); scene, BVH and memory "
-                       "image take {:.2f} s more per run, not counted\n",
-                       o.repeat, o.repeat + o.seeds - 1, r.setup_cpu_seconds);
+    out << fmt::format(
+        "host time  CPU seconds of the kernel run: median of {} (full and functional "
+        "runs) and of {} per rate (seed 1 in every round, other seeds once); "
+        "scene, BVH and memory image take {:.2f} s more per run, not counted\n",
+        o.repeat, o.repeat + o.seeds - 1, r.setup_cpu_seconds);
     out << fmt::format("full run   {} cycles, {} instructions in {:.2f} s ({:.1f} M "
                        "instructions/s)\n",
                        count_text(r.truth[0]), count_text(double(r.instructions)), full,
