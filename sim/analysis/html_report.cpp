@@ -719,7 +719,8 @@ std::string sample_check_page(const Json& doc, const std::string& chart_js) {
         "&middot; kernel {} &middot; {}</p>\n<p class=\"sub\">Sampled cycle-level simulation "
         "(render --timing sampled) against the full cycle-level run: units of {} cycles after "
         "{} cycles of warm-up, seeds 1 to {}. Host times are CPU seconds of the kernel run "
-        "(medians); errors and 95 % intervals are relative to the full run's value.</p>\n",
+        "(medians), speedups the median of the rounds' ratios to the full run; errors and 95 % "
+        "intervals are relative to the full run's value.</p>\n",
         escape(scene), text(doc, "width"), text(doc, "height"), text(doc, "samples_per_pixel"),
         escape(std::filesystem::path(text(doc, "kernel")).stem().string()),
         escape(text(doc, "chip")), readable(number(doc, "unit_cycles").value_or(0)),

@@ -69,6 +69,29 @@ double SampleCheckResult::cpu_seconds(double rate) const {
     return all.empty() ? std::nan("") : median(all);
 }
 
+namespace {
+
+/// The median over rounds of full[k] / other[k].
+double median_ratio(const std::vector<double>& full, const std::vector<double>& other) {
+    std::vector<double> ratios;
+    for (size_t k = 0; k < full.size(); ++k)
+        ratios.push_back(full[k] / other[k]);
+    return median(ratios);
+}
+
+}  // namespace
+
+double SampleCheckResult::functional_speedup() const {
+    return median_ratio(full_cpu_seconds, functional_cpu_seconds);
+}
+
+double SampleCheckResult::speedup(double rate) const {
+    const SampledRun& first = *at(rate).front();
+    if (first.cpu_seconds.size() == full_cpu_seconds.size())
+        return median_ratio(full_cpu_seconds, first.cpu_seconds);
+    return median(full_cpu_seconds) / cpu_seconds(rate);
+}
+
 Coverage SampleCheckResult::coverage(double rate, size_t statistic) const {
     Coverage c;
     std::vector<double> widths;
@@ -282,8 +305,9 @@ std::string sample_check_table(const SampleCheckOptions& o, const SampleCheckRes
                        o.seeds == 1 ? "1" : fmt::format("1-{}", o.seeds));
     out << fmt::format(
         "host time  CPU seconds of the kernel run: median of {} (full and functional "
-        "runs) and of {} per rate (seed 1 in every round, other seeds once); "
-        "scene, BVH and memory image take {:.2f} s more per run, not counted\n",
+        "runs) and of {} per rate (seed 1 in every round, other seeds once); speedups: "
+        "median of the rounds' ratios to the full run; scene, BVH and memory image take "
+        "{:.2f} s more per run, not counted\n",
         o.repeat, o.repeat + o.seeds - 1, r.setup_cpu_seconds);
     out << fmt::format("full run   {} cycles, {} instructions in {:.2f} s ({:.1f} M "
                        "instructions/s)\n",
@@ -291,7 +315,7 @@ std::string sample_check_table(const SampleCheckOptions& o, const SampleCheckRes
                        double(r.instructions) / full / 1e6);
     out << fmt::format("bound      functional only (--timing none): {:.2f} s, {:.1f}x faster than "
                        "the full run\n",
-                       functional, full / functional);
+                       functional, r.functional_speedup());
 
     out << fmt::format("\nframe cycles, seed 1 (error and interval relative to the true value)\n"
                        "{:<7} {:>6} {:>10} {:>8} {:>7} {:>14} {:>14} {:>9} {:>8} {:>7}\n",
@@ -307,7 +331,7 @@ std::string sample_check_table(const SampleCheckOptions& o, const SampleCheckRes
         const double seconds = r.cpu_seconds(rate);
         out << fmt::format(
             "{:<7} {:>6} {:>10} {:>8.2f} {:>6.1f}x {:>14} {:>14} {:>9} {:>8} {:>7}\n",
-            rate_text(rate), run.units, percent(run.cycle_level_share), seconds, full / seconds,
+            rate_text(rate), run.units, percent(run.cycle_level_share), seconds, r.speedup(rate),
             value_text(0, c.estimate), value_text(0, c.truth), percent(c.error(), true),
             percent(c.relative_half_width()), covered_text(run, c));
     }
@@ -394,14 +418,14 @@ nlohmann::ordered_json sample_check_document(const SampleCheckOptions& o,
         {"cpu_seconds", r.full_cpu_seconds}, {"median_cpu_seconds", full}, {"values", truth}};
     doc["functional"] = {{"cpu_seconds", r.functional_cpu_seconds},
                          {"median_cpu_seconds", functional},
-                         {"speedup", full / functional}};
+                         {"speedup", r.functional_speedup()}};
     Json by_rate = Json::array();
     for (double rate : rates) {
         Json entry;
         entry["rate"] = rate;
         const double seconds = r.cpu_seconds(rate);
-        entry["median_cpu_seconds"] = seconds;
-        entry["speedup"] = full / seconds;
+        entry["median_cpu_seconds"] = number(seconds);
+        entry["speedup"] = number(r.speedup(rate));
         Json coverage = Json::object();
         for (size_t s = 0; s < statistics.size(); ++s) {
             const Coverage c = r.coverage(rate, s);

@@ -94,6 +94,13 @@ struct SampleCheckResult {
     std::vector<const SampledRun*> at(double rate) const;
     /// Median CPU seconds of every timing at `rate`; NaN when every run there was refused.
     double cpu_seconds(double rate) const;
+    /// The full run's CPU time over the functional run's: the median of the rounds' ratios,
+    /// each of two runs made minutes apart (a drift of the host's speed between rounds, which
+    /// CPU time shows too on a shared virtual machine, cancels).
+    double functional_speedup() const;
+    /// The same for seed 1 at `rate`; when seed 1 was refused, the full run's median time over
+    /// cpu_seconds(rate).
+    double speedup(double rate) const;
     /// Over the seeds at `rate` that gave an estimate.
     Coverage coverage(double rate, size_t statistic) const;
 };
