@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <sstream>
+#include <utility>
 
 #include <OpenImageIO/strutil.h>
 #include <fmt/format.h>
@@ -72,6 +74,9 @@ struct Chart {
     bool tall = false;
     std::string x_title = "";  ///< scatter: the x axis title
     bool x_log = false;        ///< scatter: a logarithmic x axis
+    /// The value axis's [min, max] when set (error bars beyond it are cut); otherwise Chart.js
+    /// fits the data and its error bars.
+    std::optional<std::pair<double, double>> range = std::nullopt;
     Json labels = Json::array();
     Json datasets = Json::array();
 
@@ -88,11 +93,13 @@ struct Chart {
         return false;
     }
     Json to_json() const {
-        return {{"type", type},       {"title", title},
-                {"unit", unit},       {"horizontal", horizontal},
-                {"percent", percent}, {"log", log},
-                {"xTitle", x_title},  {"xLog", x_log},
-                {"labels", labels},   {"datasets", datasets}};
+        Json spec = {{"type", type},       {"title", title},
+                     {"unit", unit},       {"horizontal", horizontal},
+                     {"percent", percent}, {"log", log},
+                     {"xTitle", x_title},  {"xLog", x_log},
+                     {"labels", labels},   {"datasets", datasets}};
+        if (range) spec["range"] = {range->first, range->second};
+        return spec;
     }
 };
 
@@ -692,6 +699,30 @@ std::string comparison_page(const std::vector<StatsFile>& runs, const Comparison
     return page.finish("tpsim comparison", chart_js);
 }
 
+namespace {
+
+/// The value range of an error chart ({x, y, yMin, yMax} points): the points and their error
+/// bars, but no more than three times the largest error or one and a half times the median
+/// bar each way, so that a few runs with huge intervals do not flatten the rest against 0.
+std::optional<std::pair<double, double>> error_range(const Chart& chart) {
+    double largest = 0, lo = 0, hi = 0;
+    std::vector<double> halves;
+    for (const Json& dataset : chart.datasets)
+        for (const Json& p : dataset["data"]) {
+            largest = std::max(largest, std::abs(p["y"].get<double>()));
+            lo = std::min(lo, p["yMin"].get<double>());
+            hi = std::max(hi, p["yMax"].get<double>());
+            halves.push_back((p["yMax"].get<double>() - p["yMin"].get<double>()) / 2);
+        }
+    if (halves.empty()) return std::nullopt;
+    std::nth_element(halves.begin(), halves.begin() + halves.size() / 2, halves.end());
+    const double limit = std::max(3 * largest, 1.5 * halves[halves.size() / 2]);
+    if (limit == 0) return std::nullopt;
+    return std::pair(std::max(lo, -limit), std::min(hi, limit));
+}
+
+}  // namespace
+
 std::string sample_check_page(const Json& doc, const std::string& chart_js) {
     Page page;
     const auto text = [](const Json& j, const char* key) {
@@ -720,7 +751,8 @@ std::string sample_check_page(const Json& doc, const std::string& chart_js) {
         "(render --timing sampled) against the full cycle-level run: units of {} cycles after "
         "{} cycles of warm-up, seeds 1 to {}. Host times are CPU seconds of the kernel run "
         "(medians), speedups the median of the rounds' ratios to the full run; errors and 95 % "
-        "intervals are relative to the full run's value.</p>\n",
+        "intervals are relative to the full run's value (an error bar longer than its chart is "
+        "cut at the edge; the tables give it whole).</p>\n",
         escape(scene), text(doc, "width"), text(doc, "height"), text(doc, "samples_per_pixel"),
         escape(std::filesystem::path(text(doc, "kernel")).stem().string()),
         escape(text(doc, "chip")), readable(number(doc, "unit_cycles").value_or(0)),
@@ -775,6 +807,7 @@ std::string sample_check_page(const Json& doc, const std::string& chart_js) {
             }
             chart.add("rate " + text(rate, "rate"), points);
         }
+        chart.range = error_range(chart);
         errors.push_back(chart);
     }
 

@@ -38,11 +38,14 @@
     const errorBars = {
         id: 'errorBars',
         afterDatasetsDraw: function (chart) {
-            const ctx = chart.ctx, y = chart.scales.y;
+            const ctx = chart.ctx, y = chart.scales.y, area = chart.chartArea;
             chart.data.datasets.forEach(function (dataset, k) {
                 const meta = chart.getDatasetMeta(k);
                 if (meta.hidden) return;
                 ctx.save();
+                ctx.beginPath();  // a bar longer than the value range is cut at its edge
+                ctx.rect(area.left, area.top, area.right - area.left, area.bottom - area.top);
+                ctx.clip();
                 ctx.strokeStyle = dataset.borderColor;
                 ctx.lineWidth = 1.5;
                 dataset.data.forEach(function (p, i) {
@@ -62,8 +65,10 @@
             });
         }
     };
-    // The value range the error bars need (Chart.js scales to the points' y alone).
+    // The value range the error bars need (Chart.js scales to the points' y alone), or the one
+    // the page chose (spec.range: [min, max]).
     function barRange(spec) {
+        if (spec.range) return { suggestedMin: spec.range[0], suggestedMax: spec.range[1] };
         let lo = Infinity, hi = -Infinity;
         spec.datasets.forEach(function (d) {
             d.data.forEach(function (p) {
@@ -91,7 +96,7 @@
         const categoryAxis = spec.type === 'line'
             ? { type: 'linear', min: 0, max: lastCycle, title: { display: true, text: 'cycle' } }
             : scatter
-            ? { type: spec.xLog ? 'logarithmic' : 'linear',
+            ? { type: spec.xLog ? 'logarithmic' : 'linear', grace: '3%',
                 title: { display: true, text: spec.xTitle } }
             : { ticks: { autoSkip: false } };
         return {

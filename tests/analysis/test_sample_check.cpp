@@ -200,6 +200,13 @@ TEST_CASE("sample-check: truth, estimates, coverage and timings are the renders'
         CHECK(point["y"].get<double>() == Approx(100 * c.error()));
         CHECK(point["yMax"].get<double>() - point["yMin"].get<double>() ==
               Approx(200 * c.relative_half_width()));
+        // The value axis holds every error, whatever the error bars' lengths.
+        const double low = cycles["range"][0], high = cycles["range"][1];
+        for (const Json& dataset : cycles["datasets"])
+            for (const Json& p : dataset["data"]) {
+                CHECK(p["y"].get<double>() >= low);
+                CHECK(p["y"].get<double>() <= high);
+            }
         CHECK(blob["charts"].back()["title"] == "Coverage of the 95 % intervals over 2 seeds");
         CHECK(page.find("not estimated: ") != std::string::npos);
     }
