@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <sstream>
+#include <utility>
 
 #include <OpenImageIO/strutil.h>
 #include <fmt/format.h>
@@ -72,6 +74,9 @@ struct Chart {
     bool tall = false;
     std::string x_title = "";  ///< scatter: the x axis title
     bool x_log = false;        ///< scatter: a logarithmic x axis
+    /// The value axis's [min, max] when set (error bars beyond it are cut); otherwise Chart.js
+    /// fits the data and its error bars.
+    std::optional<std::pair<double, double>> range = std::nullopt;
     Json labels = Json::array();
     Json datasets = Json::array();
 
@@ -88,11 +93,13 @@ struct Chart {
         return false;
     }
     Json to_json() const {
-        return {{"type", type},       {"title", title},
-                {"unit", unit},       {"horizontal", horizontal},
-                {"percent", percent}, {"log", log},
-                {"xTitle", x_title},  {"xLog", x_log},
-                {"labels", labels},   {"datasets", datasets}};
+        Json spec = {{"type", type},       {"title", title},
+                     {"unit", unit},       {"horizontal", horizontal},
+                     {"percent", percent}, {"log", log},
+                     {"xTitle", x_title},  {"xLog", x_log},
+                     {"labels", labels},   {"datasets", datasets}};
+        if (range) spec["range"] = {range->first, range->second};
+        return spec;
     }
 };
 
@@ -778,6 +785,205 @@ std::string converge_page(const Json& doc, const std::filesystem::path& base,
         page.body << image_tag(base / text(run, "image"), text(run, "label"));
     page.body << "</div>\n";
     return page.finish("tpsim converge: " + scene, chart_js);
+}
+
+namespace {
+
+/// The value range of an error chart ({x, y, yMin, yMax} points): the points and their error
+/// bars, but no more than three times the largest error or one and a half times the median
+/// bar each way, so that a few runs with huge intervals do not flatten the rest against 0.
+std::optional<std::pair<double, double>> error_range(const Chart& chart) {
+    double largest = 0, lo = 0, hi = 0;
+    std::vector<double> halves;
+    for (const Json& dataset : chart.datasets)
+        for (const Json& p : dataset["data"]) {
+            largest = std::max(largest, std::abs(p["y"].get<double>()));
+            lo = std::min(lo, p["yMin"].get<double>());
+            hi = std::max(hi, p["yMax"].get<double>());
+            halves.push_back((p["yMax"].get<double>() - p["yMin"].get<double>()) / 2);
+        }
+    if (halves.empty()) return std::nullopt;
+    std::nth_element(halves.begin(), halves.begin() + halves.size() / 2, halves.end());
+    const double limit = std::max(3 * largest, 1.5 * halves[halves.size() / 2]);
+    if (limit == 0) return std::nullopt;
+    return std::pair(std::max(lo, -limit), std::min(hi, limit));
+}
+
+}  // namespace
+
+std::string sample_check_page(const Json& doc, const std::string& chart_js) {
+    Page page;
+    const auto text = [](const Json& j, const char* key) {
+        const auto found = j.find(key);
+        return found == j.end() || found->is_null() ? std::string()
+               : found->is_string()                 ? found->get<std::string>()
+                                                    : found->dump();
+    };
+    const auto number = [](const Json& j, const char* key) {
+        const auto found = j.find(key);
+        return found != j.end() && found->is_number() ? std::optional(found->get<double>())
+                                                      : std::nullopt;
+    };
+    const auto percent = [](std::optional<double> share, bool sign = false) {
+        if (!share) return std::string("-");
+        return sign ? fmt::format("{:+.2f} %", 100 * *share)
+                    : fmt::format("{:.2f} %", 100 * *share);
+    };
+    const std::string scene = text(doc, "scene");
+    const Json& full = doc["full"];
+    const Json& statistics = doc["statistics"];
+    const double seeds = number(doc, "seeds").value_or(1);
+    page.body << fmt::format(
+        "<h1>tpsim sample-check: {}</h1>\n<p class=\"sub\">{}x{} pixels &middot; {} spp "
+        "&middot; kernel {} &middot; {}</p>\n<p class=\"sub\">Sampled cycle-level simulation "
+        "(render --timing sampled) against the full cycle-level run: units of {} cycles after "
+        "{} cycles of warm-up, seeds 1 to {}. Host times are CPU seconds of the kernel run "
+        "(medians), speedups the median of the rounds' ratios to the full run; errors and 95 % "
+        "intervals are relative to the full run's value (an error bar longer than its chart is "
+        "cut at the edge; the tables give it whole).</p>\n",
+        escape(scene), text(doc, "width"), text(doc, "height"), text(doc, "samples_per_pixel"),
+        escape(std::filesystem::path(text(doc, "kernel")).stem().string()),
+        escape(text(doc, "chip")), readable(number(doc, "unit_cycles").value_or(0)),
+        readable(number(doc, "warmup_cycles").value_or(0)), seeds);
+    page.body << fmt::format(
+        "<p>Full cycle-level run: {} cycles, {} instructions, {:.2f} s. The bound, functional "
+        "simulation only (--timing none): {:.2f} s, <b>{:.1f}x</b> faster.</p>\n",
+        readable(full["values"].value(statistics[0].value("key", ""), 0.0)),
+        readable(number(doc, "instructions").value_or(0)),
+        number(full, "median_cpu_seconds").value_or(0),
+        number(doc["functional"], "median_cpu_seconds").value_or(0),
+        number(doc["functional"], "speedup").value_or(0));
+
+    Chart speed{.title = "Speedup over the full cycle-level run (CPU time)", .unit = "x"};
+    Json speedups = Json::array();
+    for (const Json& rate : doc["rates"]) {
+        speed.labels.push_back("rate " + text(rate, "rate"));
+        speedups.push_back(number(rate, "speedup").value_or(0));
+    }
+    speed.labels.push_back("functional (bound)");
+    speedups.push_back(number(doc["functional"], "speedup").value_or(0));
+    speed.add("speedup", speedups);
+
+    // Error against speedup, one chart per statistic, a dataset per rate; the seeds of a rate
+    // are spread a little sideways so that their intervals can be told apart.
+    std::vector<Chart> errors;
+    for (const Json& statistic : statistics) {
+        const std::string key = statistic.value("key", "");
+        Chart chart{.type = "scatter",
+                    .title = statistic.value("label", key) +
+                             ": error of the estimate, with its 95 % interval",
+                    .unit = "error (%)",
+                    .x_title = "speedup over the full run"};
+        for (const Json& rate : doc["rates"]) {
+            const double speedup = number(rate, "speedup").value_or(0);
+            const Json& runs = rate["runs"];
+            Json points = Json::array();
+            for (size_t i = 0; i < runs.size(); ++i) {
+                const auto found = runs[i].find("statistics");
+                if (found == runs[i].end()) continue;  // refused: no estimate
+                const Json& check = (*found)[key];
+                const auto error = number(check, "error");
+                const auto half = number(check, "relative_half_width");
+                if (!error || !half) continue;
+                const double spread =
+                    runs.size() > 1 ? 0.04 * ((double(i) + 0.5) / double(runs.size()) - 0.5) : 0;
+                points.push_back({{"x", speedup * (1 + spread)},
+                                  {"y", 100 * *error},
+                                  {"yMin", 100 * (*error - *half)},
+                                  {"yMax", 100 * (*error + *half)},
+                                  {"label", "seed " + text(runs[i], "seed")}});
+            }
+            chart.add("rate " + text(rate, "rate"), points);
+        }
+        chart.range = error_range(chart);
+        errors.push_back(chart);
+    }
+
+    page.body << "<div class=\"charts\">\n";
+    page.chart(speed);
+    for (const Chart& chart : errors)
+        page.chart(chart);
+    if (seeds > 1) {
+        Chart coverage{.title = fmt::format("Coverage of the 95 % intervals over {} seeds", seeds),
+                       .percent = true};
+        for (const Json& rate : doc["rates"])
+            coverage.labels.push_back("rate " + text(rate, "rate"));
+        for (const Json& statistic : statistics) {
+            Json shares = Json::array();
+            for (const Json& rate : doc["rates"]) {
+                const Json& c = rate["coverage"][statistic.value("key", "")];
+                const double runs = number(c, "runs").value_or(0);
+                shares.push_back(runs > 0 ? Json(100 * number(c, "covered").value_or(0) / runs)
+                                          : Json());
+            }
+            coverage.add(statistic.value("label", ""), shares);
+        }
+        page.chart(coverage);
+    }
+    page.body << "</div>\n";
+
+    // The tables: seed 1 at each rate, then the coverage over the seeds.
+    page.body << "<h2>Seed 1 at each rate</h2>\n<table><tr><th>statistic</th><th "
+                 "class=\"num\">rate</th><th class=\"num\">host s</th><th "
+                 "class=\"num\">speedup</th><th class=\"num\">estimate</th><th "
+                 "class=\"num\">true</th><th class=\"num\">error</th><th class=\"num\">&plusmn; "
+                 "95 %</th><th>covered</th></tr>\n";
+    for (const Json& statistic : statistics) {
+        const std::string key = statistic.value("key", "");
+        for (const Json& rate : doc["rates"]) {
+            const Json& run = rate["runs"][0];
+            const auto found = run.find("statistics");
+            page.body << fmt::format("<tr><td>{}</td><td class=\"num\">{}</td><td "
+                                     "class=\"num\">{:.2f}</td><td class=\"num\">{:.1f}x</td>",
+                                     escape(statistic.value("label", key)), text(rate, "rate"),
+                                     number(rate, "median_cpu_seconds").value_or(0),
+                                     number(rate, "speedup").value_or(0));
+            if (found == run.end()) {
+                page.body << "<td colspan=\"5\">not estimated: " << escape(text(run, "refused"))
+                          << "</td></tr>\n";
+                continue;
+            }
+            const Json& check = (*found)[key];
+            const bool exact = run.value("exact", false);
+            page.body << fmt::format(
+                "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td "
+                "class=\"num\">{}</td><td{}>{}</td></tr>\n",
+                readable(number(check, "estimate").value_or(0)),
+                readable(full["values"].value(key, 0.0)), percent(number(check, "error"), true),
+                percent(number(check, "relative_half_width")),
+                exact || check.value("covered", false) ? "" : " class=\"worse\"",
+                exact                           ? "exact"
+                : check.value("covered", false) ? "yes"
+                                                : "no");
+        }
+    }
+    page.body << "</table>\n";
+    if (seeds > 1) {
+        page.body << fmt::format(
+            "<h2>Coverage over {} seeds</h2>\n<table><tr><th>statistic</th><th "
+            "class=\"num\">rate</th><th class=\"num\">covered</th><th class=\"num\">mean "
+            "error</th><th class=\"num\">rms error</th><th class=\"num\">median &plusmn; 95 "
+            "%</th></tr>\n",
+            seeds);
+        for (const Json& statistic : statistics) {
+            const std::string key = statistic.value("key", "");
+            for (const Json& rate : doc["rates"]) {
+                const Json& c = rate["coverage"][key];
+                const double runs = number(c, "runs").value_or(0);
+                if (runs == 0) continue;
+                const double covered = number(c, "covered").value_or(0);
+                page.body << fmt::format(
+                    "<tr><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{:.0f}/{:.0f} "
+                    "({:.1f} %)</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td "
+                    "class=\"num\">{}</td></tr>\n",
+                    escape(statistic.value("label", key)), text(rate, "rate"), covered, runs,
+                    100 * covered / runs, percent(number(c, "mean_error"), true),
+                    percent(number(c, "rms_error")), percent(number(c, "median_half_width")));
+            }
+        }
+        page.body << "</table>\n";
+    }
+    return page.finish("tpsim sample-check: " + scene, chart_js);
 }
 
 }  // namespace tpsim::analysis

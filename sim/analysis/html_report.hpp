@@ -26,4 +26,8 @@ std::string comparison_page(const std::vector<StatsFile>& runs, const Comparison
 std::string converge_page(const Json& document, const std::filesystem::path& base,
                           const std::string& chart_js);
 
+/// The page of `tpsim sample-check` (its JSON document, sample_check.hpp): speedups, each
+/// statistic's error against speedup with its interval, coverage over the seeds, and the tables.
+std::string sample_check_page(const Json& document, const std::string& chart_js);
+
 }  // namespace tpsim::analysis

@@ -33,21 +33,70 @@
         const raw = context.raw;
         return (raw && raw.label ? raw.label + ': ' : '') + context.formattedValue;
     }
+    // Points with an interval, {x, y, yMin, yMax}, get a vertical bar from yMin to yMax in
+    // their dataset's colour (sample-check: an estimate's error and its confidence interval).
+    const errorBars = {
+        id: 'errorBars',
+        afterDatasetsDraw: function (chart) {
+            const ctx = chart.ctx, y = chart.scales.y, area = chart.chartArea;
+            chart.data.datasets.forEach(function (dataset, k) {
+                const meta = chart.getDatasetMeta(k);
+                if (meta.hidden) return;
+                ctx.save();
+                ctx.beginPath();  // a bar longer than the value range is cut at its edge
+                ctx.rect(area.left, area.top, area.right - area.left, area.bottom - area.top);
+                ctx.clip();
+                ctx.strokeStyle = dataset.borderColor;
+                ctx.lineWidth = 1.5;
+                dataset.data.forEach(function (p, i) {
+                    if (p === null || typeof p !== 'object' || p.yMin === undefined) return;
+                    const x = meta.data[i].x, top = y.getPixelForValue(p.yMax),
+                          bottom = y.getPixelForValue(p.yMin);
+                    ctx.beginPath();
+                    ctx.moveTo(x, top);
+                    ctx.lineTo(x, bottom);
+                    ctx.moveTo(x - 4, top);
+                    ctx.lineTo(x + 4, top);
+                    ctx.moveTo(x - 4, bottom);
+                    ctx.lineTo(x + 4, bottom);
+                    ctx.stroke();
+                });
+                ctx.restore();
+            });
+        }
+    };
+    // The value range the error bars need (Chart.js scales to the points' y alone), or the one
+    // the page chose (spec.range: [min, max]).
+    function barRange(spec) {
+        if (spec.range) return { suggestedMin: spec.range[0], suggestedMax: spec.range[1] };
+        let lo = Infinity, hi = -Infinity;
+        spec.datasets.forEach(function (d) {
+            d.data.forEach(function (p) {
+                if (p === null || typeof p !== 'object' || p.yMin === undefined) return;
+                lo = Math.min(lo, p.yMin);
+                hi = Math.max(hi, p.yMax);
+            });
+        });
+        return lo <= hi ? { suggestedMin: lo, suggestedMax: hi } : {};
+    }
     function options(spec) {
         const scatter = spec.type === 'scatter';
-        const valueAxis = {
+        const valueAxis = Object.assign({
             type: spec.log ? 'logarithmic' : 'linear',
             beginAtZero: !spec.log && !scatter,
             title: { display: !!spec.unit, text: spec.unit },
-            ticks: spec.percent ? { callback: function (v) { return v + ' %'; } } : {}
-        };
+            ticks: spec.percent ? { callback: function (v) { return v + ' %'; } } : {},
+            // Errors are read against 0, the true value: its grid line stands out.
+            grid: { color: function (c) { return c.tick && c.tick.value === 0 && scatter
+                                                 ? '#5b6170' : 'rgba(0, 0, 0, 0.1)'; } }
+        }, barRange(spec));
         // Timelines span exactly cycle 0 to the last sample.
         const lastCycle = spec.type === 'line'
             ? Math.max.apply(null, spec.datasets[0].data.map(function (p) { return p.x; })) : 0;
         const categoryAxis = spec.type === 'line'
             ? { type: 'linear', min: 0, max: lastCycle, title: { display: true, text: 'cycle' } }
             : scatter
-            ? { type: spec.xLog ? 'logarithmic' : 'linear',
+            ? { type: spec.xLog ? 'logarithmic' : 'linear', grace: '3%',
                 title: { display: true, text: spec.xTitle } }
             : { ticks: { autoSkip: false } };
         return {
@@ -76,7 +125,7 @@
                          showLine: spec.type !== 'scatter' || !!d.line };
             });
             new Chart(canvas, { type: spec.type, data: { labels: spec.labels, datasets: datasets },
-                                options: options(spec) });
+                                options: options(spec), plugins: [errorBars] });
             const shown = datasets.findIndex(function (d) { return nonzero(d); });
             if (shown < 0 || !showsColour(canvas, datasets[shown].backgroundColor))
                 throw new Error('no data drawn');

@@ -18,10 +18,10 @@ int main(int argc, char** argv) {
     // instead of "A subcommand is required".
     app.require_subcommand(0, 1);
     const tpsim::cli::Command commands[] = {
-        tpsim::cli::add_render_command(app),  tpsim::cli::add_exec_command(app),
-        tpsim::cli::add_compare_command(app), tpsim::cli::add_report_command(app),
-        tpsim::cli::add_check_command(app),   tpsim::cli::add_new_kernel_command(app),
-        tpsim::cli::add_converge_command(app)};
+        tpsim::cli::add_render_command(app),   tpsim::cli::add_exec_command(app),
+        tpsim::cli::add_compare_command(app),  tpsim::cli::add_report_command(app),
+        tpsim::cli::add_check_command(app),    tpsim::cli::add_new_kernel_command(app),
+        tpsim::cli::add_converge_command(app), tpsim::cli::add_sample_check_command(app)};
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -35,8 +35,10 @@ int main(int argc, char** argv) {
         return 2;
     }
     if (app.get_subcommands().empty()) {
-        fmt::print(stderr, "tpsim: give a subcommand: render, exec, compare, report, converge, "
-                           "new-kernel or check (tpsim --help)\n");
+        fmt::print(
+            stderr,
+            "tpsim: give a subcommand: render, exec, compare, report, converge, sample-check, "
+            "new-kernel or check (tpsim --help)\n");
         return 2;
     }
     int status = 0;

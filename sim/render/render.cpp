@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cstring>
+#include <ctime>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -35,6 +36,12 @@ KernelRun run_functional(const core::Program& program, image::MemoryImage& image
 }
 
 }  // namespace
+
+double process_cpu_seconds() {
+    timespec now{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &now);
+    return double(now.tv_sec) + 1e-9 * double(now.tv_nsec);
+}
 
 InstructionCounts InstructionCounts::of(const core::Counters& counters) {
     InstructionCounts counts;
@@ -152,6 +159,7 @@ RenderResult render(const RenderOptions& options) {
                                     ? options.max_item_instructions
                                     : default_item_instructions(result.scene);
     start = std::chrono::steady_clock::now();
+    const double cpu_start = process_cpu_seconds();
     if (options.engine == Engine::timing) {
         result.timing =
             run_timing(kernel.program, result.image, options.chip,
@@ -170,6 +178,7 @@ RenderResult render(const RenderOptions& options) {
         result.output = std::move(run.output);
     }
     result.run_seconds = seconds_since(start);
+    result.run_cpu_seconds = process_cpu_seconds() - cpu_start;
     result.traversal = image::read_thread_stats(result.image.header, result.image.words.data());
     if (result.traversal.stack_overflows > 0) {
         const std::string message = fmt::format(

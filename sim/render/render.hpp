@@ -130,7 +130,14 @@ struct RenderResult {
     std::shared_ptr<const TimingRun> timing;  ///< Engine::timing: the chip and its counters
     std::shared_ptr<const Profile> profile;   ///< RenderOptions::profile: by function and line
     double load_seconds = 0, bvh_seconds = 0, run_seconds = 0;  ///< host wall clock
+    /// Host CPU time of the kernel run (process CPU time around it): the simulator's cost,
+    /// which the machine's load disturbs much less than wall time (tpsim sample-check); it
+    /// does not see the native twin's child process.
+    double run_cpu_seconds = 0;
 };
+
+/// This process's CPU time so far, every thread's, user and system (CLOCK_PROCESS_CPUTIME_ID).
+double process_cpu_seconds();
 
 /// Runs the whole pipeline. Throws tpsim::Error (or a scene::SceneError) with one clear line,
 /// also when a traversal stack overflowed.

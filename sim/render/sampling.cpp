@@ -71,7 +71,10 @@ stats::UnitSamples run_sampled(timing::Chip& chip, const stats::Registry& chip_s
 
     // The body, until a thread runs out of work: a random start, then one stretch per period.
     stats::Snapshot tail_start = head;
-    if (!tail_begun()) {
+    // Without a body the run was measured whole; with one, it needs units to be estimated,
+    // even if the random start put the first unit past its end.
+    const bool has_body = !tail_begun();
+    if (has_body) {
         chip.drain();
         std::mt19937_64 random(options.seed);
         const double start = double(random() >> 11) * 0x1p-53;  // in [0, 1)

@@ -193,3 +193,18 @@ TEST_CASE("sampling options are checked", "[sampling]") {
     bad.unit_cycles = 0;
     CHECK_THROWS_AS(bad.validate(), Error);
 }
+
+TEST_CASE("a random start past the end of the body is refused, not taken as measured whole",
+          "[sampling][render]") {
+    // At this rate the period is longer than the body: the first unit falls past its end for
+    // most seeds, and then nothing but the head was simulated cycle by cycle.
+    render::SamplingOptions sampling;
+    sampling.rate = 0.001;
+    sampling.unit_cycles = 200;
+    sampling.warmup_cycles = 200;
+    for (uint32_t seed = 1; seed <= 4; ++seed) {
+        INFO("seed " << seed);
+        sampling.seed = seed;
+        CHECK_THROWS_WITH(render_bunny(sampling, 64), Catch::Contains("too few to estimate from"));
+    }
+}
