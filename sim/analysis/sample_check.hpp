@@ -26,8 +26,8 @@ struct CheckedStatistic {
 const std::vector<CheckedStatistic>& checked_statistics();
 
 struct SampleCheckOptions {
-    /// What every run shares: scene, kernel, chip, image size. The engine, the sampling and the
-    /// progress callback are set per run.
+    /// What every run shares: scene, kernel, chip, image size. The engine and the sampling are
+    /// set per run; on_progress hears from the cycle-level and sampled runs.
     render::RenderOptions base;
     std::vector<double> rates = {0.005, 0.01, 0.02, 0.05};
     /// Unit and warm-up of every sampled run; its rate and seed are set per run.
