@@ -209,16 +209,17 @@ void cards(Page& page, const StatsFile& run) {
     page.body << "<section class=\"cards\">\n";
     for (const Card& card : list)
         if (const auto value = run.stat(card.key)) {
-            // An estimate carries its interval, relative to it.
+            // An estimate is marked and carries its interval, relative to it; a sampled run's
+            // exact figures (instructions, rays) are not.
             const double half = run.interval(card.key);
             const std::string interval =
                 half != 0 && *value != 0
-                    ? fmt::format(" <span class=\"interval\">&plusmn; {:.2g} %</span>",
+                    ? fmt::format(" <span class=\"interval\">&plusmn;&nbsp;{:.2g}&nbsp;%</span>",
                                   100 * half / std::abs(*value))
                     : "";
             page.body << fmt::format("<div class=\"card\"><div class=\"value\">{}{}{}</div>"
                                      "<div class=\"label\">{}</div></div>\n",
-                                     run.estimated() ? "~" : "", short_number(*value * card.scale),
+                                     half != 0 ? "~" : "", short_number(*value * card.scale),
                                      card.suffix + interval, card.label);
         }
     page.body << "</section>\n";
