@@ -212,11 +212,13 @@ void cards(Page& page, const StatsFile& run) {
             // An estimate is marked and carries its interval, relative to it; a sampled run's
             // exact figures (instructions, rays) are not.
             const double half = run.interval(card.key);
-            const std::string interval =
-                half != 0 && *value != 0
-                    ? fmt::format(" <span class=\"interval\">&plusmn;&nbsp;{:.2g}&nbsp;%</span>",
-                                  100 * half / std::abs(*value))
-                    : "";
+            std::string interval;
+            if (std::isnan(half))
+                interval = " <span class=\"interval\">&plusmn;&nbsp;?</span>";
+            else if (half != 0 && *value != 0)
+                interval =
+                    fmt::format(" <span class=\"interval\">&plusmn;&nbsp;{:.2g}&nbsp;%</span>",
+                                100 * half / std::abs(*value));
             page.body << fmt::format("<div class=\"card\"><div class=\"value\">{}{}{}</div>"
                                      "<div class=\"label\">{}</div></div>\n",
                                      half != 0 ? "~" : "", short_number(*value * card.scale),
@@ -243,6 +245,12 @@ void sampling(Page& page, const StatsFile& run) {
         "executed under functional warming (docs/error-vs-time.md).</p>\n",
         100 * number("confidence"), readable(number("units")), readable(number("unit_cycles")),
         readable(number("warmup_cycles")), number("rate"), readable(number("seed")));
+    if (s.value("too_few_units", false))
+        page.body << fmt::format(
+            "<p class=\"note worse\">Too few units for these intervals to be trusted: with "
+            "fewer than {}, the intervals come out too narrow (docs/error-vs-time.md). Raise "
+            "--sample-rate, or shorten --sample-unit and --sample-warmup.</p>\n",
+            readable(number("trusted_units")));
     page.body << "<table><tr><th>statistic</th><th class=\"num\">estimate</th>"
                  "<th class=\"num\">&plusmn; 95 %</th><th class=\"num\">relative</th></tr>\n";
     for (const char* key :
@@ -254,8 +262,10 @@ void sampling(Page& page, const StatsFile& run) {
             page.body << fmt::format(
                 "<tr><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
                 "<td class=\"num\">{}</td></tr>\n",
-                key, readable(*value), readable(half),
-                *value != 0 ? fmt::format("{:.2f} %", 100 * half / std::abs(*value)) : "");
+                key, readable(*value), std::isnan(half) ? "? (no unit saw any)" : readable(half),
+                *value != 0 && !std::isnan(half)
+                    ? fmt::format("{:.2f} %", 100 * half / std::abs(*value))
+                    : "");
         }
     page.body << "</table>\n";
 }
@@ -946,6 +956,7 @@ std::string sample_check_page(const Json& doc, const std::string& chart_js) {
             }
             const Json& check = (*found)[key];
             const bool exact = run.value("exact", false);
+            const bool unknown = !exact && !number(check, "relative_half_width");
             page.body << fmt::format(
                 "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td "
                 "class=\"num\">{}</td><td{}>{}</td></tr>\n",
@@ -955,6 +966,7 @@ std::string sample_check_page(const Json& doc, const std::string& chart_js) {
                 exact || check.value("covered", false) ? "" : " class=\"worse\"",
                 exact                           ? "exact"
                 : check.value("covered", false) ? "yes"
+                : unknown                       ? "unknown"
                                                 : "no");
         }
     }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -102,7 +103,9 @@ Coverage SampleCheckResult::coverage(double rate, size_t statistic) const {
         c.covered += check.covered();
         c.mean_error += check.error();
         c.rms_error += check.error() * check.error();
-        widths.push_back(check.relative_half_width());
+        // An unknown interval is the widest of all.
+        const double width = check.relative_half_width();
+        widths.push_back(std::isnan(width) ? std::numeric_limits<double>::infinity() : width);
     }
     if (c.runs == 0) return c;
     c.mean_error /= double(c.runs);
@@ -272,6 +275,7 @@ std::string percent(double share, bool sign = false) {
 /// "yes", "no", or why there is no interval.
 std::string covered_text(const SampledRun& run, const StatisticCheck& check) {
     if (run.exact) return "exact";
+    if (std::isnan(check.half_width)) return "unknown";
     return check.covered() ? "yes" : "NO";
 }
 

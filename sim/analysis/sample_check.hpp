@@ -47,13 +47,14 @@ struct SampleCheckOptions {
 /// One statistic of one sampled run against the full run.
 struct StatisticCheck {
     double estimate = 0;
-    double half_width = 0;  ///< of the 95 % interval; 0 when measured whole (exact)
-    double truth = 0;       ///< the full run's value
+    /// Of the 95 % interval; 0 when measured whole (exact), NaN when unknown (no unit saw any).
+    double half_width = 0;
+    double truth = 0;  ///< the full run's value
 
     /// Relative to the truth (0 when both are 0).
     double error() const;
     double relative_half_width() const;
-    /// The interval contains the truth.
+    /// The interval contains the truth (an unknown one contains nothing).
     bool covered() const;
 };
 

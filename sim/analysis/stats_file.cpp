@@ -242,7 +242,9 @@ StatsFile parse_stats_file(std::string_view text, const std::filesystem::path& p
     if (document.contains("sampling")) f.sampling = r.object(document["sampling"], "\"sampling\"");
     if (document.contains("intervals"))
         for (const auto& [name, half] : r.object(document["intervals"], "\"intervals\"").items())
-            f.intervals.emplace(name, r.number(half, "\"intervals\"." + in_quotes(name)));
+            f.intervals.emplace(name, half.is_null()  // unknown
+                                          ? std::nan("")
+                                          : r.number(half, "\"intervals\"." + in_quotes(name)));
     return f;
 }
 

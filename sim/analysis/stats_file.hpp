@@ -58,12 +58,12 @@ struct StatsFile {
     std::optional<Timeline> timeline;
     std::optional<Profile> profile;
     /// A sampled run (render --timing sampled): what was sampled, and the half-width of each
-    /// estimate's confidence interval (statistics absent here are exact).
+    /// estimate's confidence interval (statistics absent here are exact; NaN: unknown).
     std::optional<Json> sampling;
     std::map<std::string, double, std::less<>> intervals;
 
     std::optional<double> stat(std::string_view name) const;
-    /// The half-width of the estimate's interval; 0 for an exact value.
+    /// The half-width of the estimate's interval; 0 for an exact value, NaN when unknown.
     double interval(std::string_view name) const;
     /// Are the statistics estimates (a sampled run)?
     bool estimated() const { return sampling && sampling->value("estimated", false); }

@@ -233,6 +233,7 @@ namespace {
 std::string with_interval(const stats::Estimate& e, std::string_view name, std::string value) {
     const double estimate = e.values.value(name);
     const double half = e.interval(name);
+    if (std::isnan(half)) return fmt::format("{} ± ? (events no unit saw)", value);
     return estimate != 0 ? fmt::format("{} ± {:.2f} %", value, 100 * half / std::abs(estimate))
                          : fmt::format("{} ± {:.3g}", value, half);
 }
@@ -262,6 +263,13 @@ void print_sampling(const RenderResult& r, const stats::Estimate& e, std::ostrea
         fmt::format("{:.0f}", e.values.value("dram/bytes_read")));
     row("DRAM bytes written", "dram/bytes_written",
         fmt::format("{:.0f}", e.values.value("dram/bytes_written")));
+    if (s.too_few_units())
+        fmt::print(out,
+                   "         WARNING: only {} units; intervals from fewer than {} come out too "
+                   "narrow (docs/error-vs-time.md): --sample-rate {:.2g} would measure about {}, "
+                   "or shorten --sample-unit and --sample-warmup\n",
+                   s.units, SamplingSummary::kTrustedUnits, s.rate_for_trusted_units(),
+                   SamplingSummary::kTrustedUnits);
 }
 
 }  // namespace
@@ -391,6 +399,8 @@ nlohmann::ordered_json stats_document(const RenderOptions& options, const Render
         sampling["warmup_cycles"] = s.options.warmup_cycles;
         sampling["seed"] = s.options.seed;
         sampling["units"] = s.units;
+        sampling["trusted_units"] = SamplingSummary::kTrustedUnits;
+        sampling["too_few_units"] = s.too_few_units();
         sampling["period_instructions"] = s.period_instructions;
         sampling["head_instructions"] = s.head_instructions;
         sampling["body_instructions"] = s.body_instructions;
@@ -403,7 +413,10 @@ nlohmann::ordered_json stats_document(const RenderOptions& options, const Render
             sampling["confidence"] = e.confidence;
             nlohmann::ordered_json intervals = nlohmann::ordered_json::object();
             for (size_t i = 0; i < e.half_width.size(); ++i)
-                if (e.half_width[i] != 0) intervals[e.values.values()[i].name] = e.half_width[i];
+                if (e.half_width[i] != 0)  // null: unknown (stats::Estimate::half_width)
+                    intervals[e.values.values()[i].name] =
+                        std::isnan(e.half_width[i]) ? nlohmann::ordered_json()
+                                                    : nlohmann::ordered_json(e.half_width[i]);
             doc["intervals"] = std::move(intervals);
         }
     }

@@ -16,6 +16,12 @@ void SamplingOptions::validate() const {
     if (unit_cycles == 0) throw Error("the sampling unit must be at least 1 cycle");
 }
 
+double SamplingSummary::rate_for_trusted_units() const {
+    const double scaled =
+        options.rate * double(kTrustedUnits) / double(std::max<uint64_t>(units, 1));
+    return std::min(1.0, scaled);
+}
+
 namespace {
 
 /// Every additive integer statistic of the chip: the ones a unit's interval measures.

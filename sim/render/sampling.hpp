@@ -41,6 +41,15 @@ struct SamplingSummary {
     uint64_t simulated_cycles = 0;     ///< cycles the cycle-level model ran, drains included
     /// The head reached the tail: every figure is measured, none estimated.
     bool exact = false;
+
+    /// Fewest units whose intervals can be trusted: with fewer, a frame's rare slow stretches
+    /// are missed by most samples and the intervals come out too narrow (measured coverage of
+    /// frame cycles 28-62 % with 2-11 units, 95-100 % from 27 on: docs/error-vs-time.md).
+    static constexpr uint64_t kTrustedUnits = 30;
+    /// An estimate from fewer units than kTrustedUnits.
+    bool too_few_units() const { return !exact && units < kTrustedUnits; }
+    /// The rate at which this run would have measured about kTrustedUnits units.
+    double rate_for_trusted_units() const;
 };
 
 /// Runs the chip (fresh, over a machine source) to its end, sampled. `chip_stats` holds the

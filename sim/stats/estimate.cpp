@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <stdexcept>
@@ -90,6 +91,9 @@ Estimate estimate(const Registry& registry, const Snapshot& measured, const Unit
     std::vector<Value>& values = result.values.values();
     // Each value's residuals d_i (empty: exact), from which its variance follows.
     std::vector<std::vector<double>> residuals(values.size());
+    // Values whose body no unit measured any of although the head or tail saw some (rare
+    // events: cold misses, DRAM reads): the residuals are all 0, yet the body may hold many.
+    std::vector<bool> unknown(values.size(), false);
     std::map<std::string, size_t, std::less<>> sampled;
     for (size_t k = 0; k < samples.names.size(); ++k)
         sampled.emplace(samples.names[k], k);
@@ -106,6 +110,7 @@ Estimate estimate(const Registry& registry, const Snapshot& measured, const Unit
         residuals[i].resize(n);
         for (size_t u = 0; u < n; ++u)
             residuals[i][u] = x[u] - ratio * samples.unit_instructions[u];
+        unknown[i] = sum == 0 && samples.exact[it->second] > 0 && units_in_body > double(n);
     }
     result.values = registry.derive(result.values);
 
@@ -127,6 +132,8 @@ Estimate estimate(const Registry& registry, const Snapshot& measured, const Unit
         for (size_t j = 0; j < e.inputs.size(); ++j) {
             const std::vector<double>& dj = residuals[e.inputs[j]];
             if (dj.empty()) continue;
+            // Not linearised: the unknown part of the input may be large.
+            if (unknown[e.inputs[j]]) unknown[i] = true;
             double slope = 1;  // a sum
             if (e.formula) {
                 const double h = 1e-6 * std::max(std::abs(inputs[j]), 1.0);
@@ -144,6 +151,10 @@ Estimate estimate(const Registry& registry, const Snapshot& measured, const Unit
     for (size_t i = 0; i < values.size(); ++i) {
         const std::vector<double>& d = residuals[i];
         if (d.empty()) continue;
+        if (unknown[i]) {
+            result.half_width[i] = std::numeric_limits<double>::quiet_NaN();
+            continue;
+        }
         double mean = 0;
         for (double di : d)
             mean += di;

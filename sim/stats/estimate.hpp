@@ -31,12 +31,15 @@ struct UnitSamples {
 
 /// Estimated statistics of a whole run.
 struct Estimate {
-    Snapshot values;                 ///< every statistic; sampled ones and their formulas estimated
-    std::vector<double> half_width;  ///< per value: the interval's half-width; 0: exact
+    Snapshot values;  ///< every statistic; sampled ones and their formulas estimated
+    /// Per value: the interval's half-width; 0: exact; NaN: unknown, because no unit saw any
+    /// of an event the head or tail saw (the body's share of it cannot be estimated).
+    std::vector<double> half_width;
     double confidence = 0.95;
     size_t units = 0;  ///< n
 
-    /// The half-width of the value called `name` (0 when exact); throws std::out_of_range.
+    /// The half-width of the value called `name` (0 when exact, NaN when unknown); throws
+    /// std::out_of_range.
     double interval(std::string_view name) const;
 };
 

@@ -108,6 +108,22 @@ TEST_CASE("the ratio estimator's interval follows Cochran's formula", "[sampling
         std::invalid_argument);
 }
 
+TEST_CASE("an event no unit saw but the head or tail did has an unknown interval, not 0",
+          "[sampling]") {
+    Toy toy;
+    // The head and tail saw 40 of x (toy_samples); no unit saw one: the body may hold any number.
+    const stats::Estimate e = stats::estimate(toy.registry, stats::Snapshot(toy.registry),
+                                              toy_samples({10, 10, 10}, {0, 0, 0}, 400));
+    CHECK(e.values.at("x").integer == 40);
+    CHECK(std::isnan(e.interval("x")));
+    CHECK(std::isnan(e.interval("x_per_instruction")));  // through the formula
+    CHECK(e.interval("chip/instructions") == Approx(0).margin(1e-9));
+    // Nothing anywhere: most likely nothing in the body either; an interval of 0.
+    stats::UnitSamples none = toy_samples({10, 10, 10}, {0, 0, 0}, 400);
+    none.exact = {100, 0};
+    CHECK(stats::estimate(toy.registry, stats::Snapshot(toy.registry), none).interval("x") == 0);
+}
+
 namespace {
 
 render::RenderResult render_bunny(std::optional<render::SamplingOptions> sampling,
