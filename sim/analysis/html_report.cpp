@@ -262,7 +262,8 @@ void sampling(Page& page, const StatsFile& run) {
             page.body << fmt::format(
                 "<tr><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
                 "<td class=\"num\">{}</td></tr>\n",
-                key, readable(*value), std::isnan(half) ? "? (no unit saw any)" : readable(half),
+                key, readable(*value),
+                std::isnan(half) ? "? (too rare: fewer than 5 units saw one)" : readable(half),
                 *value != 0 && !std::isnan(half)
                     ? fmt::format("{:.2f} %", 100 * half / std::abs(*value))
                     : "");

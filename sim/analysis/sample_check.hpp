@@ -47,7 +47,7 @@ struct SampleCheckOptions {
 /// One statistic of one sampled run against the full run.
 struct StatisticCheck {
     double estimate = 0;
-    /// Of the 95 % interval; 0 when measured whole (exact), NaN when unknown (no unit saw any).
+    /// Of the 95 % interval; 0 when measured whole (exact), NaN when unknown (too rare).
     double half_width = 0;
     double truth = 0;  ///< the full run's value
 

@@ -233,7 +233,8 @@ namespace {
 std::string with_interval(const stats::Estimate& e, std::string_view name, std::string value) {
     const double estimate = e.values.value(name);
     const double half = e.interval(name);
-    if (std::isnan(half)) return fmt::format("{} ± ? (events no unit saw)", value);
+    if (std::isnan(half))
+        return fmt::format("{} ± ? (too rare: fewer than 5 units saw one)", value);
     return estimate != 0 ? fmt::format("{} ± {:.2f} %", value, 100 * half / std::abs(estimate))
                          : fmt::format("{} ± {:.3g}", value, half);
 }

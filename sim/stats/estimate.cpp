@@ -91,8 +91,11 @@ Estimate estimate(const Registry& registry, const Snapshot& measured, const Unit
     std::vector<Value>& values = result.values.values();
     // Each value's residuals d_i (empty: exact), from which its variance follows.
     std::vector<std::vector<double>> residuals(values.size());
-    // Values whose body no unit measured any of although the head or tail saw some (rare
-    // events: cold misses, DRAM reads): the residuals are all 0, yet the body may hold many.
+    // Rare events (cold misses, DRAM reads) that most units never see: with fewer than
+    // kFewestUnitsSeen units seeing one, the residuals say little of their spread (the usual
+    // rule for a normal approximation to counts: at least 5 of them), and with none the body
+    // may still hold many if the head or tail saw some. Their intervals are unknown.
+    constexpr size_t kFewestUnitsSeen = 5;
     std::vector<bool> unknown(values.size(), false);
     std::map<std::string, size_t, std::less<>> sampled;
     for (size_t k = 0; k < samples.names.size(); ++k)
@@ -102,15 +105,20 @@ Estimate estimate(const Registry& registry, const Snapshot& measured, const Unit
         if (it == sampled.end()) continue;
         const std::vector<double>& x = samples.per_unit[it->second];
         double sum = 0;
-        for (double xi : x)
+        size_t seen = 0;
+        for (double xi : x) {
             sum += xi;
+            seen += xi != 0;
+        }
         const double ratio = sum / weights;
         const double total = ratio * samples.body_instructions + samples.exact[it->second];
         values[i].integer = uint64_t(std::llround(std::max(total, 0.0)));
         residuals[i].resize(n);
         for (size_t u = 0; u < n; ++u)
             residuals[i][u] = x[u] - ratio * samples.unit_instructions[u];
-        unknown[i] = sum == 0 && samples.exact[it->second] > 0 && units_in_body > double(n);
+        const bool rare = seen < n && seen < kFewestUnitsSeen;
+        unknown[i] =
+            rare && (seen > 0 || samples.exact[it->second] > 0) && units_in_body > double(n);
     }
     result.values = registry.derive(result.values);
 

@@ -32,8 +32,8 @@ struct UnitSamples {
 /// Estimated statistics of a whole run.
 struct Estimate {
     Snapshot values;  ///< every statistic; sampled ones and their formulas estimated
-    /// Per value: the interval's half-width; 0: exact; NaN: unknown, because no unit saw any
-    /// of an event the head or tail saw (the body's share of it cannot be estimated).
+    /// Per value: the interval's half-width; 0: exact; NaN: unknown, for an event so rare
+    /// that fewer than 5 units saw one (or none did, but the head or tail did).
     std::vector<double> half_width;
     double confidence = 0.95;
     size_t units = 0;  ///< n

@@ -108,7 +108,7 @@ TEST_CASE("the ratio estimator's interval follows Cochran's formula", "[sampling
         std::invalid_argument);
 }
 
-TEST_CASE("an event no unit saw but the head or tail did has an unknown interval, not 0",
+TEST_CASE("an event fewer than 5 units saw has an unknown interval, not a narrow one",
           "[sampling]") {
     Toy toy;
     // The head and tail saw 40 of x (toy_samples); no unit saw one: the body may hold any number.
@@ -122,6 +122,17 @@ TEST_CASE("an event no unit saw but the head or tail did has an unknown interval
     stats::UnitSamples none = toy_samples({10, 10, 10}, {0, 0, 0}, 400);
     none.exact = {100, 0};
     CHECK(stats::estimate(toy.registry, stats::Snapshot(toy.registry), none).interval("x") == 0);
+    // Seen by 4 of 8 units: too few to tell the spread; by 5, an interval.
+    const auto seen_by = [&](size_t units) {
+        std::vector<double> x(8, 0.0);
+        std::fill_n(x.begin(), units, 3.0);
+        return stats::estimate(toy.registry, stats::Snapshot(toy.registry),
+                               toy_samples(std::vector<double>(8, 10.0), x, 800))
+            .interval("x");
+    };
+    CHECK(std::isnan(seen_by(4)));
+    CHECK(seen_by(5) > 0);
+    CHECK(seen_by(8) == Approx(0).margin(1e-9));  // every unit saw the same: proportional
 }
 
 namespace {
