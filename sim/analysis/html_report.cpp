@@ -7,11 +7,11 @@
 #include <sstream>
 #include <utility>
 
-#include <OpenImageIO/strutil.h>
 #include <fmt/format.h>
 
 #include "sim/analysis/page_assets.hpp"
 #include "sim/core/error.hpp"
+#include "sim/render/image_codec.hpp"
 #include "sim/stats/thousands.hpp"
 
 namespace tpsim::analysis {
@@ -157,7 +157,7 @@ std::string image_tag(const std::filesystem::path& path, const std::string& capt
     }
     return fmt::format("<figure><img alt=\"{0}\" src=\"data:image/png;base64,{1}\">"
                        "<figcaption>{0} ({2})</figcaption></figure>\n",
-                       escape(caption), OIIO::Strutil::base64_encode(png),
+                       escape(caption), render::image_codec().base64(png),
                        escape(path.filename().string()));
 }
 

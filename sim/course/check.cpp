@@ -6,12 +6,12 @@
 #include <limits>
 #include <optional>
 
-#include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include "sim/core/error.hpp"
 #include "sim/core/fault.hpp"
+#include "sim/render/image_codec.hpp"
 #include "sim/render/image_file.hpp"
 #include "sim/render/report.hpp"
 #include "sim/stats/registry.hpp"
@@ -28,23 +28,27 @@ struct Rgb8 {
 };
 
 Rgb8 read_rgb8(const std::filesystem::path& path, std::string_view what) {
-    auto in = OIIO::ImageInput::open(path.string());
-    if (!in)
-        throw Error(fmt::format("cannot read {} {}: {}", what, path.string(), OIIO::geterror()));
-    Rgb8 image{in->spec().width, in->spec().height, {}};
-    image.pixels.resize(size_t(image.width) * image.height * 3);
-    // Channels past the third (alpha) are dropped; a grey image is refused by the size check.
-    if (in->spec().nchannels < 3 ||
-        !in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, image.pixels.data()))
+    render::Image file;
+    std::string error;
+    if (!render::image_codec().read(path.string(), render::PixelType::UInt8, file, error))
+        throw Error(fmt::format("cannot read {} {}: {}", what, path.string(), error));
+    const int channels = file.layout.channels;
+    if (channels < 3)
         throw Error(fmt::format("cannot read {} {}: it must be an RGB image", what, path.string()));
+    // Channels past the third (alpha) are dropped.
+    Rgb8 image{file.layout.width, file.layout.height, {}};
+    image.pixels.resize(size_t(image.width) * image.height * 3);
+    for (size_t pixel = 0; pixel < size_t(image.width) * image.height; ++pixel)
+        std::copy_n(file.bytes.begin() + pixel * channels, 3, image.pixels.begin() + pixel * 3);
     return image;
 }
 
 void write_rgb8(const std::filesystem::path& path, const Rgb8& image) {
-    auto out = OIIO::ImageOutput::create(path.string());
-    const OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
-    if (!out || !out->open(path.string(), spec) ||
-        !out->write_image(OIIO::TypeDesc::UINT8, image.pixels.data()) || !out->close())
+    const render::ImageLayout layout{image.width, image.height, 3, render::PixelType::UInt8, {},
+                                     {}};
+    std::string error;
+    if (!render::image_codec().write(path.string(), layout, std::span<const uint8_t>(image.pixels),
+                                     error))
         throw Error(fmt::format("cannot write image '{}'", path.string()));
 }
 

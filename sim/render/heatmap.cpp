@@ -4,13 +4,11 @@
 #include <cctype>
 #include <cmath>
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
-#include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 
 #include "sim/core/error.hpp"
 #include "sim/core/output_directory.hpp"
+#include "sim/render/image_codec.hpp"
 #include "sim/stats/thousands.hpp"
 
 namespace tpsim::render {
@@ -65,14 +63,12 @@ struct Canvas {
     }
 };
 
-/// Writes `what` with OpenImageIO, naming the path in any error.
-void write_buffer(OIIO::ImageBuf& buffer, const std::filesystem::path& path, OIIO::TypeDesc type) {
-    // OpenImageIO stamps the file with the current time unless DateTime is given; empty leaves it
-    // out, so the same run gives the same bytes.
-    buffer.specmod().attribute("DateTime", "");
-    if (!buffer.write(path.string(), type))
-        throw Error(
-            fmt::format("cannot write heat map '{}': {}", path.string(), buffer.geterror()));
+/// Writes float pixels as `file` says, naming the path in any error.
+void write_pixels(const std::filesystem::path& path, const ImageLayout& file,
+                  std::span<const float> pixels) {
+    std::string error;
+    if (!image_codec().write(path.string(), file, pixels, error))
+        throw Error(fmt::format("cannot write heat map '{}': {}", path.string(), error));
 }
 
 }  // namespace
@@ -145,12 +141,12 @@ HeatmapFiles write_heatmap(const std::filesystem::path& png_path,
     HeatmapFiles files{png_path, std::filesystem::path(png_path).replace_extension(".exr"), ""};
     const std::vector<double> values = heat_values(costs, width, height, metric);
 
-    std::vector<float> raw(values.begin(), values.end());
-    OIIO::ImageSpec exr_spec(int(width), int(height), 1, OIIO::TypeDesc::FLOAT);
-    exr_spec.channelnames = {"Y"};
-    exr_spec.attribute("tpsim:metric", std::string(metric_name(metric)));
-    OIIO::ImageBuf exr(exr_spec, raw.data());
-    write_buffer(exr, files.exr, OIIO::TypeDesc::FLOAT);
+    const std::vector<float> raw(values.begin(), values.end());
+    const std::pair<std::string, std::string> metric_attribute{"tpsim:metric",
+                                                               std::string(metric_name(metric))};
+    write_pixels(
+        files.exr,
+        ImageLayout{int(width), int(height), 1, PixelType::Float, {"Y"}, {metric_attribute}}, raw);
 
     const auto [lowest, highest] = std::minmax_element(values.begin(), values.end());
     const double low = *lowest, range = *highest - *lowest;
@@ -162,13 +158,12 @@ HeatmapFiles write_heatmap(const std::filesystem::path& png_path,
     };
     const auto colour = [&](double v) { return inferno(position(v)); };
 
-    namespace algo = OIIO::ImageBufAlgo;
+    const ImageCodec& codec = image_codec();
     const std::string low_text = grouped(low), high_text = grouped(*highest);
     const std::string label =
         std::string(kMetricLabels[size_t(metric)]) + (log_scale ? " (log scale)" : "");
-    const auto text_width = [](const std::string& text) {
-        const OIIO::ROI size = algo::text_size(text, kFontSize, kFont);
-        return size.defined() ? size.width() : 0;
+    const auto text_width = [&](const std::string& text) {
+        return codec.text_width(text, kFontSize, kFont);
     };
 
     const uint32_t magnify = std::clamp((kMinWidth + width - 1) / width, 1u, kMaxMagnify);
@@ -194,23 +189,30 @@ HeatmapFiles write_heatmap(const std::filesystem::path& png_path,
                        frame ? kFrame : inferno(float(x - bar_left) / (bar_right - bar_left - 1)));
         }
 
-    OIIO::ImageSpec png_spec(canvas.width, canvas.height, 3, OIIO::TypeDesc::FLOAT);
-    png_spec.attribute("oiio:ColorSpace", "sRGB");  // the colour map's values are sRGB-encoded
-    png_spec.attribute("tpsim:metric", std::string(metric_name(metric)));
-    OIIO::ImageBuf png(png_spec, canvas.rgb.data());
     const int baseline = map_height + kTextBaseline;
+    std::string error;
+    const auto draw = [&](int x, int y, const std::string& text, TextAlign align) {
+        return codec.draw_text(canvas.rgb, canvas.width, canvas.height, x, y, text, kFontSize,
+                               kFont, kText, align, error);
+    };
     const bool text =
-        algo::render_text(png, bar_left, baseline, low_text, kFontSize, kFont, kText) &&
-        algo::render_text(png, canvas.width / 2, baseline + (label_row ? kTextRow : 0), label,
-                          kFontSize, kFont, kText, algo::TextAlignX::Center) &&
-        algo::render_text(png, bar_right, baseline, high_text, kFontSize, kFont, kText,
-                          algo::TextAlignX::Right);
+        draw(bar_left, baseline, low_text, TextAlign::Left) &&
+        draw(canvas.width / 2, baseline + (label_row ? kTextRow : 0), label, TextAlign::Center) &&
+        draw(bar_right, baseline, high_text, TextAlign::Right);
     if (!text)
         files.legend_problem = fmt::format(
             "heat map '{}' has no legend text: OpenImageIO could not draw it ({}); install the "
             "font {} (Debian fonts-dejavu-core)",
-            png_path.string(), png.geterror(), kFont);
-    write_buffer(png, files.png, OIIO::TypeDesc::UINT8);
+            png_path.string(), error, kFont);
+    // The colour map's values are sRGB-encoded.
+    write_pixels(files.png,
+                 ImageLayout{canvas.width,
+                             canvas.height,
+                             3,
+                             PixelType::UInt8,
+                             {},
+                             {{"oiio:ColorSpace", "sRGB"}, metric_attribute}},
+                 canvas.rgb);
     return files;
 }
 

@@ -6,11 +6,11 @@
 #include <string>
 #include <vector>
 
-#include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 
 #include "sim/core/error.hpp"
 #include "sim/core/output_directory.hpp"
+#include "sim/render/image_codec.hpp"
 
 namespace tpsim::render {
 namespace {
@@ -38,8 +38,7 @@ float decode_srgb(uint8_t value) {
 }
 
 void check_image_path(const std::filesystem::path& path) {
-    if (!OIIO::ImageOutput::create(path.string())) {
-        OIIO::geterror();  // consumed here: the message below says it better
+    if (!image_codec().can_write(path.string())) {
         throw Error(fmt::format(
             "cannot write image '{}': {}; use .png, .exr, .tif, .ppm ...", path.string(),
             path.has_extension()
@@ -51,40 +50,38 @@ void check_image_path(const std::filesystem::path& path) {
 
 void write_image(const std::filesystem::path& path, std::span<const float> rgb, uint32_t width,
                  uint32_t height) {
-    auto out = OIIO::ImageOutput::create(path.string());
-    if (!out)
-        throw Error(fmt::format("cannot write image '{}': {} (use .png, .exr, .tif, .ppm ...)",
-                                path.string(), OIIO::geterror()));
     const bool linear = is_float_format(path.extension().string());
-    OIIO::ImageSpec spec(int(width), int(height), 3,
-                         linear ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
-    spec.attribute("oiio:ColorSpace", linear ? "linear" : "sRGB");
-    // OpenImageIO stamps TIFF and EXR files with the current time unless DateTime is given;
-    // empty leaves it out, so the same render gives the same bytes.
-    spec.attribute("DateTime", "");
-    bool ok = out->open(path.string(), spec);
-    if (ok && linear) {
-        ok = out->write_image(OIIO::TypeDesc::FLOAT, rgb.data());
-    } else if (ok) {
+    const ImageLayout file{int(width), int(height),
+                           3,          linear ? PixelType::Float : PixelType::UInt8,
+                           {},         {{"oiio:ColorSpace", linear ? "linear" : "sRGB"}}};
+    std::string error;
+    bool ok;
+    if (linear) {
+        ok = image_codec().write(path.string(), file, rgb, error);
+    } else {
         std::vector<uint8_t> bytes(rgb.size());
         std::transform(rgb.begin(), rgb.end(), bytes.begin(), encode_srgb);
-        ok = out->write_image(OIIO::TypeDesc::UINT8, bytes.data());
+        ok = image_codec().write(path.string(), file, std::span<const uint8_t>(bytes), error);
     }
-    if (!ok || !out->close())
-        throw Error(fmt::format("cannot write image '{}': {}", path.string(), out->geterror()));
+    if (!ok) throw Error(fmt::format("cannot write image '{}': {}", path.string(), error));
 }
 
 std::vector<float> read_image(const std::filesystem::path& path, uint32_t& width,
                               uint32_t& height) {
-    auto in = OIIO::ImageInput::open(path.string());
-    if (!in)
-        throw Error(fmt::format("cannot read image '{}': {}", path.string(), OIIO::geterror()));
-    const OIIO::ImageSpec& spec = in->spec();
-    width = uint32_t(spec.width);
-    height = uint32_t(spec.height);
+    Image image;
+    std::string error;
+    if (!image_codec().read(path.string(), PixelType::Float, image, error))
+        throw Error(fmt::format("cannot read image '{}': {}", path.string(), error));
+    const ImageLayout& layout = image.layout;
+    if (layout.channels < 3)
+        throw Error(fmt::format("cannot read image '{}': it has {} channels, not RGB",
+                                path.string(), layout.channels));
+    width = uint32_t(layout.width);
+    height = uint32_t(layout.height);
+    // The first three channels (alpha and beyond dropped).
     std::vector<float> rgb(size_t(width) * height * 3);
-    if (!in->read_image(0, 0, 0, 3, OIIO::TypeDesc::FLOAT, rgb.data()))
-        throw Error(fmt::format("cannot read image '{}': {}", path.string(), in->geterror()));
+    for (size_t pixel = 0; pixel < size_t(width) * height; ++pixel)
+        std::copy_n(image.floats.begin() + pixel * layout.channels, 3, rgb.begin() + pixel * 3);
     return rgb;
 }
 

@@ -1,4 +1,4 @@
-// Writes a rendered framebuffer to disk through OpenImageIO.
+// Writes a rendered framebuffer to disk through the image module (OpenImageIO).
 #pragma once
 #include <cstdint>
 #include <filesystem>
