@@ -1,18 +1,34 @@
 #include "sim/scene/bvh.hpp"
 
 #include <algorithm>
+#include <array>
+#include <atomic>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <stdexcept>
+#include <utility>
 
 #include <fmt/format.h>
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/parallel_invoke.h>
 
 namespace tpsim::scene {
 
-float Aabb::surface_area() const {
+namespace {
+
+/// The one definition of a box's surface area (empty boxes have none), inlined in the sweeps.
+inline float surface_area(const glm::vec3& lo, const glm::vec3& hi) {
     const glm::vec3 d = glm::max(hi - lo, glm::vec3(0.f));
     return 2.f * (d.x * d.y + d.y * d.z + d.z * d.x);
+}
+
+}  // namespace
+
+float Aabb::surface_area() const {
+    return scene::surface_area(lo, hi);
 }
 
 bool Aabb::contains(const Aabb& inner) const {
@@ -39,7 +55,7 @@ struct Box {
         lo = glm::min(lo, p);
         hi = glm::max(hi, p);
     }
-    float area() const { return Aabb{lo, hi}.surface_area(); }
+    float area() const { return surface_area(lo, hi); }
 };
 
 /// Most triangles a subtree can hold when its leaves may sit at most `levels` below its root.
@@ -76,7 +92,7 @@ public:
     BuilderBase(std::span<const Triangle> triangles, const BvhConfig& config) : config_(config) {
         boxes_.resize(triangles.size());
         centroids_.resize(triangles.size());
-        for (size_t i = 0; i < triangles.size(); ++i) {
+        tbb::parallel_for(size_t{0}, triangles.size(), [&](size_t i) {
             const Triangle& t = triangles[i];
             Box b;
             b.grow(t.v0);
@@ -84,7 +100,7 @@ public:
             b.grow(t.v2);
             boxes_[i] = b;
             centroids_[i] = (b.lo + b.hi) * 0.5f;
-        }
+        });
     }
 
 protected:
@@ -99,14 +115,14 @@ protected:
         const bool fits_leaf = count <= config_.max_leaf_size;
         if (levels_left == 0) {
             if (best.valid() && best.cost + node_area < double(count) * node_area)
-                ++stats_.depth_limited_nodes;
+                ++depth_limited_nodes_;
             return {true, {}};
         }
         if (fits_leaf &&
             (!feasible.valid() || double(count) * node_area <= node_area + feasible.cost))
             return {true, {}};
         if (best.valid() && (!feasible.valid() || feasible.cost > best.cost))
-            ++stats_.depth_limited_nodes;
+            ++depth_limited_nodes_;
         return {false, feasible};
     }
 
@@ -125,6 +141,8 @@ protected:
     std::vector<glm::vec3> centroids_;
     std::vector<BvhNode> nodes_;
     BvhStats stats_;
+    /// Counted from several threads by the sweep builder; copied into the stats at the end.
+    std::atomic<uint32_t> depth_limited_nodes_{0};
 };
 
 /// Half the range [begin, end) of `order` to each side of the object median by centroid on the
@@ -143,110 +161,220 @@ uint32_t partition_at_median(std::vector<uint32_t>& order, const std::vector<glm
     return middle;
 }
 
-/// Exact SAH over object splits: the triangles of every node are kept sorted by centroid on
-/// each axis (three index lists, presorted once, partitioned stably per node), and every split
-/// position on every axis is evaluated: O(n log n) presort + O(n) per tree level.
+/// Exact SAH over object splits (the full sweep): the triangles of every node are kept sorted by
+/// centroid on each axis (three lists, presorted once, partitioned stably per node), and every
+/// split position on every axis is evaluated: O(n log n) presort + O(n) per tree level.
+///
+/// What makes it fast, as in the well-known full-sweep builders: the lists hold the triangles'
+/// boxes themselves, so the sweeps and partitions stream through memory instead of gathering
+/// boxes by index; the presort is a radix sort; the node's three axes are swept in parallel
+/// and the two subtrees are built in parallel (oneTBB's default arena, so a process-wide
+/// tbb::global_control limits the threads) above a size cutoff.
+///
+/// Same tree for any thread count: each node depends only on its range of the lists, the split
+/// chosen is the first best candidate in (axis, position) order however the axes are swept,
+/// and the nodes, made in whatever order the threads get to them, are laid out depth-first
+/// at the end.
 class SweepBuilder : BuilderBase {
 public:
     SweepBuilder(std::span<const Triangle> triangles, const BvhConfig& config)
         : BuilderBase(triangles, config) {
-        const uint32_t n = uint32_t(triangles.size());
-        for (int axis = 0; axis < 3; ++axis) {
-            auto& order = order_[axis];
-            order.resize(n);
-            for (uint32_t i = 0; i < n; ++i)
-                order[i] = i;
-            // Index tie-break makes the order (and so the tree) independent of the sort algorithm.
-            std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
-                const float ca = centroids_[a][axis], cb = centroids_[b][axis];
-                return ca < cb || (ca == cb && a < b);
-            });
-        }
-        right_area_.resize(n);
+        const size_t n = triangles.size();
+        tbb::parallel_invoke([&] { presort(0); }, [&] { presort(1); }, [&] { presort(2); });
+        boxes_ = {};
+        centroids_ = {};
+        for (auto& areas : right_area_)
+            areas.resize(n);
         goes_right_.resize(n);
         scratch_.resize(n);
+        // A binary tree with at most n leaves has at most 2n - 1 nodes.
+        build_nodes_.reset(new BuildNode[2 * n - 1]);
     }
 
     Bvh build() {
-        nodes_.reserve(2 * order_[0].size());
-        build_node(0, uint32_t(order_[0].size()), config_.traversal_stack_entries);
-        return Bvh{std::move(nodes_), std::move(order_[0]), std::move(stats_)};
+        const uint32_t n = uint32_t(refs_[0].size());
+        build_node(0, 0, n, config_.traversal_stack_entries);
+        Bvh bvh;
+        bvh.nodes.reserve(next_node_);
+        lay_out(bvh.nodes, 0);
+        bvh.triangle_order.resize(n);
+        for (uint32_t i = 0; i < n; ++i)
+            bvh.triangle_order[i] = refs_[0][i].triangle;
+        bvh.stats = std::move(stats_);
+        bvh.stats.depth_limited_nodes = depth_limited_nodes_;
+        return bvh;
     }
 
 private:
-    void build_node(uint32_t begin, uint32_t end, uint32_t levels_left) {
-        const uint32_t count = end - begin;
-        Box bounds;
-        for (uint32_t i = begin; i < end; ++i)
-            bounds.grow(boxes_[order_[0][i]]);
-        const uint32_t index = emit_node(bounds);
+    /// A triangle's box in a sorted list.
+    struct Ref {
+        Box box;
+        uint32_t triangle;
+    };
+    /// A node as built: an interior node's children are build_nodes_[first] and [first + 1].
+    /// Trivial, so the pool's unused part is never touched.
+    struct BuildNode {
+        glm::vec3 lo, hi;
+        uint32_t first;  ///< leaf: first entry of the range; interior: the left child
+        uint32_t count;  ///< leaf: triangles; 0 for interior nodes
+    };
+    /// Nodes with fewer triangles build both subtrees on one thread, and sweep their axes one
+    /// after the other: below these, handing work to another thread costs more than it saves.
+    static constexpr uint32_t kParallelSubtrees = 4096;
+    static constexpr uint32_t kParallelAxes = 65536;
 
+    /// Sorts refs_[axis] by centroid, ties by triangle index: a stable LSD radix sort (three
+    /// 11-bit digits) of keys that order like the floats, started in index order.
+    void presort(int axis) {
+        const uint32_t n = uint32_t(centroids_.size());
+        std::vector<uint64_t> keys(n), sorted(n);  // key << 32 | triangle
+        for (uint32_t i = 0; i < n; ++i) {
+            // + 0.f turns -0 into +0, which compares equal to it; then negative floats get
+            // their bits flipped, positive ones the sign bit set, so the integers order alike.
+            const uint32_t bits = std::bit_cast<uint32_t>(centroids_[i][axis] + 0.f);
+            const uint32_t key = bits & 0x80000000u ? ~bits : bits | 0x80000000u;
+            keys[i] = uint64_t(key) << 32 | i;
+        }
+        for (int shift = 32; shift < 64; shift += 11) {
+            std::array<uint32_t, 2048> start{};
+            for (uint64_t k : keys)
+                ++start[(k >> shift) & 2047];
+            uint32_t sum = 0;
+            for (uint32_t& s : start)
+                sum += std::exchange(s, sum);
+            for (uint64_t k : keys)
+                sorted[start[(k >> shift) & 2047]++] = k;
+            keys.swap(sorted);
+        }
+        auto& refs = refs_[axis];
+        refs.resize(n);
+        for (uint32_t i = 0; i < n; ++i) {
+            const uint32_t t = uint32_t(keys[i]);
+            refs[i] = Ref{boxes_[t], t};
+        }
+    }
+
+    void build_node(uint32_t index, uint32_t begin, uint32_t end, uint32_t levels_left) {
+        const uint32_t count = end - begin;
+        Box bounds = refs_[0][begin].box;
         Split best, feasible;
-        if (count > 1) find_splits(begin, end, child_capacity(levels_left), best, feasible);
+        if (count > 1) find_splits(begin, end, child_capacity(levels_left), bounds, best, feasible);
+        BuildNode& node = build_nodes_[index];
+        node = BuildNode{bounds.lo, bounds.hi, 0, 0};
         const NodeChoice choice = decide(count, bounds.area(), levels_left, best, feasible);
         if (choice.make_leaf) {
-            nodes_[index].first_triangle = begin;
-            nodes_[index].triangle_count = count;
+            node.first = begin;
+            node.count = count;
             return;
         }
         partition(begin, end, choice.split);
         const uint32_t middle = begin + choice.split.left_count;
-        build_node(begin, middle, levels_left - 1);
-        nodes_[index].right_child = uint32_t(nodes_.size());
-        build_node(middle, end, levels_left - 1);
+        const uint32_t left = next_node_.fetch_add(2, std::memory_order_relaxed);
+        node.first = left;
+        const auto build_left = [&] { build_node(left, begin, middle, levels_left - 1); };
+        const auto build_right = [&] { build_node(left + 1, middle, end, levels_left - 1); };
+        if (count >= kParallelSubtrees) {
+            tbb::parallel_invoke(build_left, build_right);
+        } else {
+            build_left();
+            build_right();
+        }
     }
 
-    void find_splits(uint32_t begin, uint32_t end, uint64_t child_cap, Split& best,
+    /// Also grows `bounds` (holding the range's first box) to the range's bounds.
+    void find_splits(uint32_t begin, uint32_t end, uint64_t child_cap, Box& bounds, Split& best,
                      Split& feasible) {
-        const uint32_t count = end - begin;
-        for (int axis = 0; axis < 3; ++axis) {
-            const auto& order = order_[axis];
-            Box right;
-            for (uint32_t i = end - 1; i > begin; --i) {
-                right.grow(boxes_[order[i]]);
-                right_area_[i] = right.area();
-            }
-            Box left;
-            for (uint32_t i = begin; i + 1 < end; ++i) {
-                left.grow(boxes_[order[i]]);
-                const uint32_t left_count = i + 1 - begin, right_count = count - left_count;
-                const Split candidate{axis, left_count, left_count,
-                                      double(left.area()) * left_count +
-                                          double(right_area_[i + 1]) * right_count};
-                if (better(candidate, best, count)) best = candidate;
-                if (left_count <= child_cap && right_count <= child_cap &&
-                    better(candidate, feasible, count))
-                    feasible = candidate;
-            }
+        std::array<Split, 3> axis_best, axis_feasible;
+        const auto sweep = [&](int axis) {
+            const Box suffix =
+                sweep_axis(axis, begin, end, child_cap, axis_best[axis], axis_feasible[axis]);
+            if (axis == 0) bounds.grow(suffix);
+        };
+        if (end - begin >= kParallelAxes) {
+            tbb::parallel_invoke([&] { sweep(0); }, [&] { sweep(1); }, [&] { sweep(2); });
+        } else {
+            for (int axis = 0; axis < 3; ++axis)
+                sweep(axis);
         }
+        // In axis order, as one sweep over all three would pick.
+        for (int axis = 0; axis < 3; ++axis) {
+            if (better(axis_best[axis], best, end - begin)) best = axis_best[axis];
+            if (better(axis_feasible[axis], feasible, end - begin)) feasible = axis_feasible[axis];
+        }
+    }
+
+    /// Returns the bounds of all but the range's first box.
+    Box sweep_axis(int axis, uint32_t begin, uint32_t end, uint64_t child_cap, Split& best,
+                   Split& feasible) {
+        const uint32_t count = end - begin;
+        const Ref* refs = refs_[axis].data();
+        float* right_area = right_area_[axis].data();  // [i]: area of the range's suffix from i
+        Box right;
+        for (uint32_t i = end - 1; i > begin; --i) {
+            right.grow(refs[i].box);
+            right_area[i] = right.area();
+        }
+        // Every split is feasible when either side may take all but one triangle.
+        const bool all_feasible = child_cap >= count - 1;
+        Box left;
+        for (uint32_t i = begin; i + 1 < end; ++i) {
+            left.grow(refs[i].box);
+            const uint32_t left_count = i + 1 - begin, right_count = count - left_count;
+            const Split candidate{axis, left_count, left_count,
+                                  double(left.area()) * left_count +
+                                      double(right_area[i + 1]) * right_count};
+            if (better(candidate, best, count)) best = candidate;
+            if (!all_feasible && left_count <= child_cap && right_count <= child_cap &&
+                better(candidate, feasible, count))
+                feasible = candidate;
+        }
+        if (all_feasible) feasible = best;
+        return right;
     }
 
     /// Splits the range on the chosen axis and carries the split over to the other two sorted
     /// lists with a stable partition, so they stay sorted.
     void partition(uint32_t begin, uint32_t end, const Split& split) {
         const uint32_t middle = begin + split.position;
-        const auto& chosen = order_[split.axis];
+        const Ref* chosen = refs_[split.axis].data();
         for (uint32_t i = begin; i < end; ++i)
-            goes_right_[chosen[i]] = i >= middle;
+            goes_right_[chosen[i].triangle] = i >= middle;
         for (int axis = 0; axis < 3; ++axis) {
             if (axis == split.axis) continue;
-            auto& order = order_[axis];
-            uint32_t left = begin, right = 0;
+            Ref* refs = refs_[axis].data();
+            Ref* right = scratch_.data() + begin;  // this range's part: subtrees never overlap
+            uint32_t left = begin, right_count = 0;
             for (uint32_t i = begin; i < end; ++i) {
-                const uint32_t t = order[i];
-                if (goes_right_[t])
-                    scratch_[right++] = t;
+                if (goes_right_[refs[i].triangle])
+                    right[right_count++] = refs[i];
                 else
-                    order[left++] = t;
+                    refs[left++] = refs[i];
             }
-            std::copy(scratch_.begin(), scratch_.begin() + right, order.begin() + left);
+            std::copy(right, right + right_count, refs + left);
         }
     }
 
-    std::vector<uint32_t> order_[3];
-    std::vector<float> right_area_;    // right_area_[i]: area of the range's suffix from i
-    std::vector<uint8_t> goes_right_;  // per triangle, for the current partition
-    std::vector<uint32_t> scratch_;
+    /// Appends the subtree of build_nodes_[index] depth-first: left child right after its parent.
+    void lay_out(std::vector<BvhNode>& nodes, uint32_t index) const {
+        const BuildNode& node = build_nodes_[index];
+        const uint32_t out = uint32_t(nodes.size());
+        nodes.push_back(BvhNode{Aabb{node.lo, node.hi}, 0, 0, 0});
+        if (node.count != 0) {
+            nodes[out].first_triangle = node.first;
+            nodes[out].triangle_count = node.count;
+            return;
+        }
+        lay_out(nodes, node.first);
+        nodes[out].right_child = uint32_t(nodes.size());
+        lay_out(nodes, node.first + 1);
+    }
+
+    std::array<std::vector<Ref>, 3> refs_;
+    std::array<std::vector<float>, 3> right_area_;
+    std::vector<uint8_t> goes_right_;  // per triangle, for the partition of its node
+    std::vector<Ref> scratch_;
+    std::unique_ptr<BuildNode[]> build_nodes_;
+    std::atomic<uint32_t> next_node_{1};  // build_nodes_[0] is the root
 };
 
 /// Binned SAH after Wald 2007: centroids are binned into `bins` equal slots per axis and only
@@ -266,6 +394,7 @@ public:
     Bvh build() {
         nodes_.reserve(2 * order_.size());
         build_node(0, uint32_t(order_.size()), config_.traversal_stack_entries);
+        stats_.depth_limited_nodes = depth_limited_nodes_;
         return Bvh{std::move(nodes_), std::move(order_), std::move(stats_)};
     }
 

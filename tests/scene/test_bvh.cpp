@@ -1,9 +1,11 @@
+#include <bit>
 #include <cmath>
 #include <filesystem>
 #include <limits>
 #include <random>
 
 #include <catch2/catch.hpp>
+#include <oneapi/tbb/global_control.h>
 
 #include "sim/scene/bvh.hpp"
 #include "sim/scene/load_scene.hpp"
@@ -103,6 +105,36 @@ std::vector<Triangle> geometric_strip(uint32_t count) {
 
 const BvhBuilder kBuilders[] = {BvhBuilder::sweep, BvhBuilder::binned};
 
+/// FNV-1a over every field of every node, then the triangle order: equal digests mean the same
+/// memory image of the tree.
+uint64_t digest(const Bvh& bvh) {
+    uint64_t h = 14695981039346656037ull;
+    const auto add = [&](uint32_t word) {
+        for (int byte = 0; byte < 4; ++byte) {
+            h ^= (word >> (8 * byte)) & 0xff;
+            h *= 1099511628211ull;
+        }
+    };
+    for (const BvhNode& node : bvh.nodes) {
+        for (int k = 0; k < 3; ++k) {
+            add(std::bit_cast<uint32_t>(node.bounds.lo[k]));
+            add(std::bit_cast<uint32_t>(node.bounds.hi[k]));
+        }
+        add(node.right_child);
+        add(node.first_triangle);
+        add(node.triangle_count);
+    }
+    for (uint32_t t : bvh.triangle_order)
+        add(t);
+    return h;
+}
+
+/// The sweep builder's tree of `triangles` on at most `threads` host threads.
+Bvh build_on_threads(const std::vector<Triangle>& triangles, size_t threads) {
+    const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    return build_bvh(triangles, {.builder = BvhBuilder::sweep});
+}
+
 }  // namespace
 
 TEST_CASE("A hand-computed two-triangle tree has the expected SAH cost", "[bvh]") {
@@ -155,6 +187,37 @@ TEST_CASE("Builds are deterministic", "[bvh]") {
             REQUIRE(a.nodes[i].triangle_count == b.nodes[i].triangle_count);
         }
     }
+}
+
+TEST_CASE("The sweep builder gives the same tree on 1, 2, 3 and 8 threads", "[bvh]") {
+    // Big enough that the axes are swept in parallel and subtrees built in parallel; the
+    // strip's depth limit makes the feasible split differ from the best one.
+    for (const auto& triangles : {random_soup(150000, 11), geometric_strip(20000)}) {
+        const Bvh one = build_on_threads(triangles, 1);
+        check_invariants(one, triangles, {});
+        for (size_t threads : {2, 3, 8}) {
+            const Bvh many = build_on_threads(triangles, threads);
+            CHECK(digest(many) == digest(one));
+            CHECK(many.stats.nodes == one.stats.nodes);
+            CHECK(many.stats.max_depth == one.stats.max_depth);
+            CHECK(many.stats.sah_cost == one.stats.sah_cost);
+            CHECK(many.stats.depth_limited_nodes == one.stats.depth_limited_nodes);
+            CHECK(many.stats.leaf_size_histogram == one.stats.leaf_size_histogram);
+        }
+    }
+}
+
+TEST_CASE("The sweep builder's trees are pinned: any change moves the reference figures", "[bvh]") {
+    // Digests of the trees the single-threaded builder of 2026-11 made (before the parallel,
+    // streaming one): its tree decides every cycle count in the README. A new digest here means
+    // a new tree; say so and update the figures.
+    CHECK(digest(build_bvh(random_soup(150000, 11))) == 0xef37273e464691a7ull);
+    CHECK(digest(build_bvh(geometric_strip(20000))) == 0xd90c9ac967f87702ull);
+    CHECK(digest(build_bvh(load_scene(TPSIM_SCENES_DIR "/cornell.toml").triangles)) ==
+          0xb7ee23433d63882bull);
+    const std::filesystem::path bunny = TPSIM_SCENES_DIR "/bunny.toml";
+    if (std::filesystem::exists("/usr/share/glmark2/models/bunny.obj"))
+        CHECK(digest(build_bvh(load_scene(bunny).triangles)) == 0xdbd157326eb537deull);
 }
 
 TEST_CASE("The depth limit holds on a 2^20-triangle geometric strip", "[bvh][slow]") {
