@@ -199,17 +199,34 @@ public:
         lay_out(bvh.nodes, 0);
         bvh.triangle_order.resize(n);
         for (uint32_t i = 0; i < n; ++i)
-            bvh.triangle_order[i] = refs_[0][i].triangle;
+            bvh.triangle_order[i] = refs_[0][i].triangle();
         bvh.stats = std::move(stats_);
         bvh.stats.depth_limited_nodes = depth_limited_nodes_;
         return bvh;
     }
 
 private:
-    /// A triangle's box in a sorted list.
+    /// Four floats in one SIMD register (a GCC/Clang vector type): one min or max grows a box.
+    using Float4 = float __attribute__((vector_size(16)));
+    /// A triangle's box in a sorted list: lanes 0-2 of lo and hi; the triangle's index is kept
+    /// as bits in hi's lane 3, which box arithmetic never reads.
     struct Ref {
-        Box box;
-        uint32_t triangle;
+        Float4 lo, hi;
+        uint32_t triangle() const { return std::bit_cast<uint32_t>(hi[3]); }
+    };
+    /// A growing box of Refs, exactly as Box grows (the same min and max, lane by lane).
+    struct Box4 {
+        Float4 lo = Float4{} + std::numeric_limits<float>::infinity();
+        Float4 hi = Float4{} - std::numeric_limits<float>::infinity();
+        void grow(const Float4& other_lo, const Float4& other_hi) {
+            lo = other_lo < lo ? other_lo : lo;
+            hi = hi < other_hi ? other_hi : hi;
+        }
+        void grow(const Ref& r) { grow(r.lo, r.hi); }
+        void grow(const Box4& b) { grow(b.lo, b.hi); }
+        glm::vec3 low() const { return {lo[0], lo[1], lo[2]}; }
+        glm::vec3 high() const { return {hi[0], hi[1], hi[2]}; }
+        float area() const { return surface_area(low(), high()); }
     };
     /// A node as built: an interior node's children are build_nodes_[first] and [first + 1].
     /// Trivial, so the pool's unused part is never touched.
@@ -250,17 +267,20 @@ private:
         refs.resize(n);
         for (uint32_t i = 0; i < n; ++i) {
             const uint32_t t = uint32_t(keys[i]);
-            refs[i] = Ref{boxes_[t], t};
+            const Box& b = boxes_[t];
+            refs[i] = Ref{Float4{b.lo.x, b.lo.y, b.lo.z, 0.f},
+                          Float4{b.hi.x, b.hi.y, b.hi.z, std::bit_cast<float>(t)}};
         }
     }
 
     void build_node(uint32_t index, uint32_t begin, uint32_t end, uint32_t levels_left) {
         const uint32_t count = end - begin;
-        Box bounds = refs_[0][begin].box;
+        Box4 bounds;
+        bounds.grow(refs_[0][begin]);
         Split best, feasible;
         if (count > 1) find_splits(begin, end, child_capacity(levels_left), bounds, best, feasible);
         BuildNode& node = build_nodes_[index];
-        node = BuildNode{bounds.lo, bounds.hi, 0, 0};
+        node = BuildNode{bounds.low(), bounds.high(), 0, 0};
         const NodeChoice choice = decide(count, bounds.area(), levels_left, best, feasible);
         if (choice.make_leaf) {
             node.first = begin;
@@ -282,11 +302,11 @@ private:
     }
 
     /// Also grows `bounds` (holding the range's first box) to the range's bounds.
-    void find_splits(uint32_t begin, uint32_t end, uint64_t child_cap, Box& bounds, Split& best,
+    void find_splits(uint32_t begin, uint32_t end, uint64_t child_cap, Box4& bounds, Split& best,
                      Split& feasible) {
         std::array<Split, 3> axis_best, axis_feasible;
         const auto sweep = [&](int axis) {
-            const Box suffix =
+            const Box4 suffix =
                 sweep_axis(axis, begin, end, child_cap, axis_best[axis], axis_feasible[axis]);
             if (axis == 0) bounds.grow(suffix);
         };
@@ -304,21 +324,21 @@ private:
     }
 
     /// Returns the bounds of all but the range's first box.
-    Box sweep_axis(int axis, uint32_t begin, uint32_t end, uint64_t child_cap, Split& best,
-                   Split& feasible) {
+    Box4 sweep_axis(int axis, uint32_t begin, uint32_t end, uint64_t child_cap, Split& best,
+                    Split& feasible) {
         const uint32_t count = end - begin;
         const Ref* refs = refs_[axis].data();
         float* right_area = right_area_[axis].data();  // [i]: area of the range's suffix from i
-        Box right;
+        Box4 right;
         for (uint32_t i = end - 1; i > begin; --i) {
-            right.grow(refs[i].box);
+            right.grow(refs[i]);
             right_area[i] = right.area();
         }
         // Every split is feasible when either side may take all but one triangle.
         const bool all_feasible = child_cap >= count - 1;
-        Box left;
+        Box4 left;
         for (uint32_t i = begin; i + 1 < end; ++i) {
-            left.grow(refs[i].box);
+            left.grow(refs[i]);
             const uint32_t left_count = i + 1 - begin, right_count = count - left_count;
             const Split candidate{axis, left_count, left_count,
                                   double(left.area()) * left_count +
@@ -338,14 +358,14 @@ private:
         const uint32_t middle = begin + split.position;
         const Ref* chosen = refs_[split.axis].data();
         for (uint32_t i = begin; i < end; ++i)
-            goes_right_[chosen[i].triangle] = i >= middle;
+            goes_right_[chosen[i].triangle()] = i >= middle;
         for (int axis = 0; axis < 3; ++axis) {
             if (axis == split.axis) continue;
             Ref* refs = refs_[axis].data();
             Ref* right = scratch_.data() + begin;  // this range's part: subtrees never overlap
             uint32_t left = begin, right_count = 0;
             for (uint32_t i = begin; i < end; ++i) {
-                if (goes_right_[refs[i].triangle])
+                if (goes_right_[refs[i].triangle()])
                     right[right_count++] = refs[i];
                 else
                     refs[left++] = refs[i];
