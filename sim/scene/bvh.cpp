@@ -168,8 +168,9 @@ uint32_t partition_at_median(std::vector<uint32_t>& order, const std::vector<glm
 /// What makes it fast, as in the well-known full-sweep builders: the lists hold the triangles'
 /// boxes themselves, so the sweeps and partitions stream through memory instead of gathering
 /// boxes by index; the presort is a radix sort; the node's three axes are swept in parallel
-/// and the two subtrees are built in parallel (oneTBB's default arena, so a process-wide
-/// tbb::global_control limits the threads) above a size cutoff.
+/// and the two subtrees are built in parallel above a size cutoff (in oneTBB's current arena,
+/// the default one unless the caller chose another, so a process-wide tbb::global_control
+/// limits the threads).
 ///
 /// Same tree for any thread count: each node depends only on its range of the lists, the split
 /// chosen is the first best candidate in (axis, position) order however the axes are swept,
@@ -209,7 +210,7 @@ private:
     /// Four floats in one SIMD register (a GCC/Clang vector type): one min or max grows a box.
     using Float4 = float __attribute__((vector_size(16)));
     /// A triangle's box in a sorted list: lanes 0-2 of lo and hi; the triangle's index is kept
-    /// as bits in hi's lane 3, which box arithmetic never reads.
+    /// as bits in hi's lane 3, whose grown value nothing reads.
     struct Ref {
         Float4 lo, hi;
         uint32_t triangle() const { return std::bit_cast<uint32_t>(hi[3]); }
@@ -276,9 +277,11 @@ private:
     void build_node(uint32_t index, uint32_t begin, uint32_t end, uint32_t levels_left) {
         const uint32_t count = end - begin;
         Box4 bounds;
-        bounds.grow(refs_[0][begin]);
         Split best, feasible;
-        if (count > 1) find_splits(begin, end, child_capacity(levels_left), bounds, best, feasible);
+        if (count > 1)
+            find_splits(begin, end, child_capacity(levels_left), bounds, best, feasible);
+        else
+            bounds.grow(refs_[0][begin]);
         BuildNode& node = build_nodes_[index];
         node = BuildNode{bounds.low(), bounds.high(), 0, 0};
         const NodeChoice choice = decide(count, bounds.area(), levels_left, best, feasible);
@@ -301,14 +304,18 @@ private:
         }
     }
 
-    /// Also grows `bounds` (holding the range's first box) to the range's bounds.
+    /// Also sets `bounds` to the range's bounds, grown in list order on axis 0 as the previous
+    /// builder grew them (where -0 and +0 meet, the order decides which one a bound keeps).
     void find_splits(uint32_t begin, uint32_t end, uint64_t child_cap, Box4& bounds, Split& best,
                      Split& feasible) {
         std::array<Split, 3> axis_best, axis_feasible;
         const auto sweep = [&](int axis) {
-            const Box4 suffix =
+            const Box4 prefix =
                 sweep_axis(axis, begin, end, child_cap, axis_best[axis], axis_feasible[axis]);
-            if (axis == 0) bounds.grow(suffix);
+            if (axis == 0) {
+                bounds = prefix;
+                bounds.grow(refs_[0][end - 1]);
+            }
         };
         if (end - begin >= kParallelAxes) {
             tbb::parallel_invoke([&] { sweep(0); }, [&] { sweep(1); }, [&] { sweep(2); });
@@ -323,7 +330,7 @@ private:
         }
     }
 
-    /// Returns the bounds of all but the range's first box.
+    /// Returns the bounds of all but the range's last box, grown in list order.
     Box4 sweep_axis(int axis, uint32_t begin, uint32_t end, uint64_t child_cap, Split& best,
                     Split& feasible) {
         const uint32_t count = end - begin;
@@ -349,7 +356,7 @@ private:
                 feasible = candidate;
         }
         if (all_feasible) feasible = best;
-        return right;
+        return left;
     }
 
     /// Splits the range on the chosen axis and carries the split over to the other two sorted
