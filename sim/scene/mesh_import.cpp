@@ -64,8 +64,8 @@ PlyType ply_type(const std::string& type) {
 
 /// Assimp 5.2's PLY reader loops forever on a truncated header, aborts (ai_assert) on a truncated
 /// body or a face without vertices, and allocates for whatever counts the header claims. So PLY
-/// files are walked here first: the header must end, every element must fit in the body, and
-/// every face must have vertices, all within range.
+/// files are walked here first: the header must end, every element must fit in the body (an
+/// ASCII item on its own line), and every face must have vertices, all within range.
 void check_ply(const std::string& where, const std::string& bytes) {
     const auto fail = [&](const std::string& why) { malformed(where, "PLY", why); };
     struct Property {
@@ -148,11 +148,17 @@ void check_ply(const std::string& where, const std::string& bytes) {
     };
 
     if (ascii) {
+        // Item by item, a line each, as assimp reads them: a line must hold its item's values
+        // (assimp ignores any beyond them).
         std::istringstream body(bytes.substr(at));
-        std::string token;
+        std::string line, token;
+        std::istringstream item;
+        const auto next_token = [&] {
+            if (!(item >> token)) fail("body ends early");
+        };
         const auto next_integer = [&] {
             int64_t value = 0;
-            if (!(body >> token)) fail("body ends early");
+            next_token();
             const auto [end, error] =
                 std::from_chars(token.data(), token.data() + token.size(), value);
             if (error != std::errc() || end != token.data() + token.size())
@@ -160,7 +166,12 @@ void check_ply(const std::string& where, const std::string& bytes) {
             return value;
         };
         for (const Element& element : elements)
-            for (uint64_t i = 0; i < element.count; ++i)
+            for (uint64_t i = 0; i < element.count; ++i) {
+                do
+                    if (!std::getline(body, line)) fail("body ends early");
+                while (line.find_first_not_of(" \t\r") == std::string::npos);
+                item.clear();
+                item.str(line);
                 for (const Property& property : element.properties) {
                     int64_t items = 1;
                     if (property.count_type.size != 0) {
@@ -172,9 +183,10 @@ void check_ply(const std::string& where, const std::string& bytes) {
                     for (int64_t k = 0; k < items; ++k)
                         if (property.vertex_indices)
                             check_index(element, i, next_integer());
-                        else if (!(body >> token))
-                            fail("body ends early");
+                        else
+                            next_token();
                 }
+            }
         return;
     }
     const std::string_view body = std::string_view(bytes).substr(at);
