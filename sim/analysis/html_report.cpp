@@ -249,7 +249,7 @@ void sampling(Page& page, const StatsFile& run) {
         page.body << fmt::format(
             "<p class=\"note worse\">Too few units for these intervals to be trusted: with "
             "fewer than {}, the intervals come out too narrow (docs/error-vs-time.md). Raise "
-            "--sample-rate, or shorten --sample-unit and --sample-warmup.</p>\n",
+            "--sample-rate.</p>\n",
             readable(number("trusted_units")));
     page.body << "<table><tr><th>statistic</th><th class=\"num\">estimate</th>"
                  "<th class=\"num\">&plusmn; 95 %</th><th class=\"num\">relative</th></tr>\n";

@@ -267,8 +267,7 @@ void print_sampling(const RenderResult& r, const stats::Estimate& e, std::ostrea
     if (s.too_few_units())
         fmt::print(out,
                    "         WARNING: only {} units; intervals from fewer than {} come out too "
-                   "narrow (docs/error-vs-time.md): --sample-rate {:.2g} would measure about {}, "
-                   "or shorten --sample-unit and --sample-warmup\n",
+                   "narrow (docs/error-vs-time.md): --sample-rate {:.2g} would measure about {}\n",
                    s.units, SamplingSummary::kTrustedUnits, s.rate_for_trusted_units(),
                    SamplingSummary::kTrustedUnits);
 }
