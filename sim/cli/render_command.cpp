@@ -15,6 +15,7 @@
 #include "sim/cli/commands.hpp"
 #include "sim/cli/progress_line.hpp"
 #include "sim/core/error.hpp"
+#include "sim/core/host_threads.hpp"
 #include "sim/render/heatmap.hpp"
 #include "sim/render/image_file.hpp"
 #include "sim/render/profile.hpp"
@@ -316,6 +317,13 @@ Command add_render_command(CLI::App& app) {
                      "(200-400 rows)")
         ->check(kWholeNumber)
         ->capture_default_str();
+    command
+        ->add_option_function<uint32_t>(
+            "--threads", [](uint32_t threads) { core::set_host_threads(threads); },
+            "Host threads to simulate on (the chip's TMs, the functional machine's threads); "
+            "the image and every statistic are the same for any number")
+        ->check(kPositiveCount)
+        ->default_str(std::to_string(core::host_threads()));
     command
         ->add_option("--max-instructions", o->max_instructions,
                      "Instructions a thread may run before it is stopped as a runaway")

@@ -1,13 +1,19 @@
 #include "sim/core/machine.hpp"
 
 #include <algorithm>
+#include <atomic>
+#include <barrier>
 #include <bit>
+#include <exception>
+#include <thread>
+#include <type_traits>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include "isa/csr.hpp"
 #include "sim/core/error.hpp"
+#include "sim/core/ordered_turns.hpp"
 #include "sim/core/thread_env.hpp"
 
 namespace tpsim::core {
@@ -62,6 +68,7 @@ Machine::Machine(Program program, const MachineConfig& config)
     }
 
     threads_.resize(config_.threads);
+    counter_lanes_.resize((config_.threads + config_.threads_per_tm - 1) / config_.threads_per_tm);
     running_threads_ = live_threads_ = config_.threads;
     semaphore_holder_.fill(kNoThread);
     output_ = trax::KernelOutput(config_.threads);
@@ -136,11 +143,23 @@ void Machine::limit_fault(uint32_t id) {
            "raise it with --max-instructions, or look for an endless loop"});
 }
 
-void Machine::run_quantum(uint32_t id, uint64_t budget) {
+namespace {
+
+/// run_quantum's turn on one host thread: nothing to wait for.
+struct NoTurn {
+    void operator()() const {}
+};
+
+}  // namespace
+
+template <class Turn> void Machine::run_quantum(uint32_t id, uint64_t budget, Turn&& turn) {
+    // Until its turn, a quantum on several host threads checks each instruction for privacy.
+    bool my_turn = std::is_same_v<std::decay_t<Turn>, NoTurn>;
     Thread& t = threads_[id];
     isa::Hart& h = t.hart;
     ThreadEnv<false> env(*this, id);
-    uint64_t* per_op = counters_.per_op.data();
+    Counters& counters = counters_of(id);
+    uint64_t* per_op = counters.per_op.data();
     uint64_t done = 0;
     uint32_t pc = h.pc;
     const CodeRange* range = &entry_code_;
@@ -159,6 +178,10 @@ void Machine::run_quantum(uint32_t id, uint64_t budget) {
                 const uint32_t index = std::rotr(pc - text_base, 2);
                 if (index >= text_words) [[unlikely]]
                     break;
+                if (!my_turn && !is_private(h, index, text_words, range->first)) {
+                    turn();
+                    my_turn = true;
+                }
                 const isa::Decoded& d = decoded[index];
                 ++per_op[size_t(d.op)];
                 isa::execute<ThreadEnv<false>, false>(d, h, env);
@@ -169,7 +192,7 @@ void Machine::run_quantum(uint32_t id, uint64_t budget) {
         } catch (const GuestFault& f) {
             if (!take_trap(h, f)) {
                 t.executed += done;
-                counters_.instructions += done;
+                counters.instructions += done;
                 fault(id, pc, f);
             }
             // A load or store fault the handler takes: the quantum goes on at the handler.
@@ -177,14 +200,30 @@ void Machine::run_quantum(uint32_t id, uint64_t budget) {
             continue;
         }
         if (done == budget || t.state != ThreadState::Running) break;
+        if (!my_turn) {  // a fetch fault reads nothing shared, but must come in its turn
+            turn();
+            my_turn = true;
+        }
         range = code_range_at(pc);  // the pc left the range: another one, or a fetch fault
         if (!range) fetch_fault(id, pc);
     }
     t.executed += done;
-    counters_.instructions += done;
+    counters.instructions += done;
 }
 
-void Machine::run() {
+Counters Machine::counters() const {
+    Counters sum;
+    for (const CounterLane& lane : counter_lanes_) {
+        sum.instructions += lane.counters.instructions;
+        for (size_t op = 0; op < sum.per_op.size(); ++op)
+            sum.per_op[op] += lane.counters.per_op[op];
+    }
+    return sum;
+}
+
+void Machine::run(uint32_t host_threads) {
+    const auto lanes = uint32_t(std::min<size_t>(host_threads, counter_lanes_.size()));
+    if (lanes > 1) return run_lanes(lanes);
     // Waiting threads are passed over; one that goes on runs again in its turn. The loop ends
     // when no thread is left running: suspend() and exited() report a deadlock before then.
     while (running_threads_ != 0)
@@ -193,8 +232,93 @@ void Machine::run() {
             if (t.state != ThreadState::Running) continue;
             const uint64_t left = instructions_left(t);
             if (left == 0) limit_fault(id);
-            run_quantum(id, std::min<uint64_t>(left, config_.quantum));
+            run_quantum(id, std::min<uint64_t>(left, config_.quantum), NoTurn{});
         }
+}
+
+// run()'s rounds on `lanes` host threads: lane l takes the threads of TMs l, l + lanes, ...
+// Thread `id`'s quantum in round r has position r * threads + id in the order of run()'s
+// single loop; what it does that others can see waits for that turn (OrderedTurns).
+void Machine::run_lanes(uint32_t lanes) {
+    OrderedTurns turns(lanes);
+    const uint64_t threads = thread_count();
+    const uint32_t per_tm = config_.threads_per_tm;
+    bool more_rounds = running_threads_ != 0;
+    // Between rounds, one look at running_threads_ decides for every lane.
+    std::atomic<uint64_t> first_failure{OrderedTurns::kDone};
+    std::barrier round_end(lanes, [&]() noexcept {
+        more_rounds = running_threads_ != 0 && first_failure.load() == OrderedTurns::kDone;
+    });
+    // Whether each thread waits (at the barrier, for a semaphore), as its own lane last saw it.
+    std::vector<uint8_t> waiting(threads, 0);
+    std::vector<std::exception_ptr> failures(lanes);
+    std::vector<uint64_t> failed_at(lanes, OrderedTurns::kDone);
+    const auto lane_work = [&](uint32_t lane) {
+        uint64_t position = 0;
+        try {
+            for (uint64_t round = 0; more_rounds; ++round) {
+                for (uint32_t tm = lane; tm * per_tm < threads; tm += lanes)
+                    for (uint32_t id = tm * per_tm;
+                         id < std::min<uint64_t>(threads, (tm + 1) * per_tm); ++id) {
+                        Thread& t = threads_[id];
+                        position = round * threads + id;
+                        turns.reach(lane, position);
+                        const auto wait_turn = [&] {
+                            turns.wait_turn(lane, position);
+                            if (first_failure.load() < position) throw OrderedTurns::Abandoned{};
+                        };
+                        // Only this lane runs the thread, but a waiting thread is let go by
+                        // another's instruction: its state is read in turn.
+                        if (waiting[id]) {
+                            wait_turn();
+                            waiting[id] = t.state == ThreadState::Waiting;
+                        }
+                        if (t.state != ThreadState::Running) continue;
+                        const uint64_t left = instructions_left(t);
+                        if (left == 0) {
+                            wait_turn();
+                            limit_fault(id);
+                        }
+                        run_quantum(id, std::min<uint64_t>(left, config_.quantum), wait_turn);
+                        waiting[id] = t.state == ThreadState::Waiting;
+                    }
+                turns.reach(lane, (round + 1) * threads);
+                round_end.arrive_and_wait();
+            }
+            turns.reach(lane, OrderedTurns::kDone);
+            return;
+        } catch (const OrderedTurns::Abandoned&) {
+        } catch (...) {
+            // The first failure in the order is the one run() on one host thread reports, with
+            // the output printed before it.
+            turns.wait_turn(lane, position);
+            std::exception_ptr error = std::current_exception();
+            try {
+                throw;
+            } catch (const Fault& f) {
+                error =
+                    std::make_exception_ptr(Fault(f.kind(), f.thread(), f.pc(), f.what(), output_));
+            } catch (...) {
+            }
+            failures[lane] = error;
+            failed_at[lane] = position;
+            uint64_t earliest = first_failure.load();
+            while (position < earliest &&
+                   !first_failure.compare_exchange_weak(earliest, position)) {
+            }
+        }
+        turns.reach(lane, OrderedTurns::kDone);
+        round_end.arrive_and_drop();
+    };
+    std::vector<std::thread> helpers;
+    for (uint32_t lane = 1; lane < lanes; ++lane)
+        helpers.emplace_back(lane_work, lane);
+    lane_work(0);
+    for (std::thread& helper : helpers)
+        helper.join();
+    if (first_failure.load() == OrderedTurns::kDone) return;
+    for (uint32_t lane = 0; lane < lanes; ++lane)
+        if (failed_at[lane] == first_failure.load()) std::rethrow_exception(failures[lane]);
 }
 
 // Out of line: CSR reads are rare, and inlined into the flattened step they would only add
@@ -203,8 +327,9 @@ bool Machine::read_csr(uint32_t id, uint32_t csr, uint32_t& value) const {
     namespace c = isa::csr;
     const uint32_t per_tm = config_.threads_per_tm;
     // Functionally every instruction takes one cycle, so cycle = instret; the timing model
-    // supplies real cycles (set_cycle_counter). (instret itself is the hart's.)
-    const uint64_t cycles = cycle_counter_ ? *cycle_counter_ : threads_[id].hart.instret;
+    // supplies real cycles (set_cycle_counters). (instret itself is the hart's.)
+    const uint64_t cycles =
+        cycle_counters_ ? cycle_counters_[id / per_tm * cycle_stride_] : threads_[id].hart.instret;
     switch (csr) {
     case c::kMhartid:
         value = id;

@@ -8,6 +8,7 @@
 
 #include "isa/hart.hpp"
 #include "kernel/kernel_output.hpp"
+#include "kernel/memory_map.hpp"
 #include "sim/core/elf_loader.hpp"
 #include "sim/core/fault.hpp"
 #include "sim/core/memory.hpp"
@@ -61,6 +62,12 @@ struct Thread {
     uint64_t item_start = 0;
 };
 
+/// Whether a guest address is private to each thread: its local store, the overflow guard below
+/// it and the unmapped space above (an access there touches the thread's own store or faults).
+constexpr bool in_local_store(uint32_t addr) {
+    return addr >= trax::map::kLocalTop - trax::map::kStackGuard;
+}
+
 /// What one instruction did, for the timing model (step()).
 struct StepRecord {
     uint32_t pc = 0;  ///< address of the instruction
@@ -70,9 +77,11 @@ struct StepRecord {
     const isa::Decoded* insn = nullptr;  ///< its pre-decoded form (registers, FU class)
     uint32_t mem_address = 0;            ///< effective address when mem_bytes != 0
     uint8_t mem_bytes = 0;               ///< access size; 0 = no memory access
-    bool mem_store = false;
-    bool taken = false;   ///< control left the fall-through path (branch, jump, trap)
-    bool exited = false;  ///< the instruction ended the thread
+    bool mem_store : 1 = false;
+    /// The access is to the thread's local store (in_local_store): no cache, no traffic.
+    bool mem_local : 1 = false;
+    bool taken : 1 = false;   ///< control left the fall-through path (branch, jump, trap)
+    bool exited : 1 = false;  ///< the instruction ended the thread
 };
 static_assert(sizeof(StepRecord) == 24, "the timing model buffers 128 per thread");
 
@@ -92,8 +101,11 @@ public:
 
     /// Runs every thread to its exit, round-robin by thread id in fixed quanta (a waiting thread
     /// is passed over until it may go on), so results never depend on anything but the program
-    /// and the config. Throws Fault on the first guest fault, a deadlock included.
-    void run();
+    /// and the config. Throws Fault on the first guest fault, a deadlock included. On several
+    /// host threads (each takes the threads of every host_threads-th TM), instructions that are
+    /// not private run in the turn (round, thread) they have in that order, so nothing depends
+    /// on the number.
+    void run(uint32_t host_threads = 1);
 
     /// Executes one instruction of a running thread and reports what it did. Throws Fault.
     StepRecord step(uint32_t thread);
@@ -113,10 +125,19 @@ public:
     inline bool run_observed(uint32_t id, uint64_t budget, uint64_t& executed, StepRecord& last,
                              Observer& observer);
 
-    /// Timing mode: the cycle/time CSRs read `*cycles` (the chip's current cycle) instead of
-    /// instret; nullptr (the default) = functional mode, where cycle = instret. The counter
-    /// must outlive the instructions that read it.
-    void set_cycle_counter(const uint64_t* cycles) { cycle_counter_ = cycles; }
+    /// Timing mode: the cycle/time CSRs of a thread in TM t read `cycles[t * stride]` (the
+    /// cycle that TM is simulating: TMs may be simulated on different host threads, each at
+    /// its own cycle) instead of instret; nullptr (the default) = functional mode, where
+    /// cycle = instret. The counters must outlive the instructions that read them.
+    void set_cycle_counters(const uint64_t* cycles, uint32_t stride) {
+        cycle_counters_ = cycles;
+        cycle_stride_ = stride;
+    }
+    /// Whether thread `id`'s next instruction is private (is_private): running it at any
+    /// moment, whatever other threads run meanwhile, gives the same result. False for an
+    /// instruction that touches shared state, and for a thread that is not running.
+    /// Defined in thread_env.hpp.
+    inline bool next_is_private(uint32_t id) const;
 
     const Program& program() const { return program_; }
     const MachineConfig& config() const { return config_; }
@@ -135,7 +156,8 @@ public:
         uint32_t first = 0;  ///< index of the first word in the decoded array
     };
     const std::vector<CodeRange>& code() const { return code_; }
-    const Counters& counters() const { return counters_; }
+    /// Instructions executed, summed over the TMs' counters.
+    Counters counters() const;
     uint32_t global_register(uint32_t index) const { return global_registers_.at(index); }
     /// What the threads printed (tp.print).
     const trax::KernelOutput& output() const { return output_; }
@@ -143,7 +165,10 @@ public:
 private:
     template <bool kRecord, class Observer> friend class ThreadEnv;
 
-    void run_quantum(uint32_t id, uint64_t budget);
+    /// Runs up to `budget` instructions of thread `id`. `turn` is called before the first one
+    /// that is not private (and nothing else is checked) unless it is a NoTurn.
+    template <class Turn> void run_quantum(uint32_t id, uint64_t budget, Turn&& turn);
+    void run_lanes(uint32_t lanes);
     /// The code range holding the aligned pc, or nullptr (a fetch fault). Cold: the run loops
     /// keep the current range in locals and ask only when the pc leaves it.
     [[gnu::cold]] const CodeRange* code_range_at(uint32_t pc) const;
@@ -235,8 +260,18 @@ private:
     static constexpr uint32_t kNoThread = UINT32_MAX;
     std::array<uint32_t, kGlobalRegisters> semaphore_holder_;
     trax::KernelOutput output_;
-    Counters counters_;
-    const uint64_t* cycle_counter_ = nullptr;
+    /// The counters of the threads of TM t in counter_lanes_[t] (t = thread / threads_per_tm),
+    /// each on its own cache lines: TMs simulated on different host threads never write the
+    /// same counters.
+    struct alignas(64) CounterLane {
+        Counters counters;
+    };
+    std::vector<CounterLane> counter_lanes_;
+    Counters& counters_of(uint32_t id) {
+        return counter_lanes_[id / config_.threads_per_tm].counters;
+    }
+    const uint64_t* cycle_counters_ = nullptr;
+    uint32_t cycle_stride_ = 0;
 };
 
 }  // namespace tpsim::core

@@ -131,6 +131,7 @@ private:
         record_->mem_address = addr;
         record_->mem_bytes = bytes;
         record_->mem_store = store;
+        record_->mem_local = in_local_store(addr);
     }
 
     Machine& machine_;
@@ -161,7 +162,8 @@ private:
     ThreadEnv<true> env(*this, id, out);
     // Locals, not members (as in run_quantum): stores through the hart's registers could alias
     // members, and the compiler would reload them every instruction.
-    uint64_t* per_op = counters_.per_op.data();
+    Counters& counters = counters_of(id);
+    uint64_t* per_op = counters.per_op.data();
     const isa::Decoded* decoded = decoded_.data() + entry_code_.first;
     uint32_t first = entry_code_.first;
     uint32_t text_base = entry_code_.base;
@@ -170,7 +172,7 @@ private:
     const auto count = [&] {
         done = n;
         t.executed += n;
-        counters_.instructions += n;
+        counters.instructions += n;
     };
     uint32_t pc = h.pc;
     try {
@@ -210,6 +212,7 @@ private:
         StepRecord& record = out[n++];
         record.mem_bytes = 0;
         record.mem_store = false;
+        record.mem_local = false;
         record.taken = true;
     } catch (...) {
         count();
@@ -232,7 +235,8 @@ template <class Observer>
         limit_fault(id);
     isa::Hart& h = t.hart;
     ThreadEnv<false, Observer> env(*this, id, {}, &observer);
-    uint64_t* per_op = counters_.per_op.data();
+    Counters& counters = counters_of(id);
+    uint64_t* per_op = counters.per_op.data();
     const isa::Decoded* decoded = decoded_.data() + entry_code_.first;
     uint32_t text_base = entry_code_.base;
     uint32_t text_words = entry_code_.words;
@@ -278,19 +282,19 @@ template <class Observer>
         if (!take_trap(h, f)) {
             executed = n;
             t.executed += n;
-            counters_.instructions += n;
+            counters.instructions += n;
             fault(id, pc, f);
         }
         ++n;  // the access did not happen; the trap handler runs next
     } catch (...) {
         executed = n;
         t.executed += n;
-        counters_.instructions += n;
+        counters.instructions += n;
         throw;
     }
     executed = n;
     t.executed += n;
-    counters_.instructions += n;
+    counters.instructions += n;
     return stopped;
 }
 
@@ -305,8 +309,18 @@ inline bool Machine::is_private(const isa::Hart& h, uint32_t index, uint32_t wor
     // the same value whenever they run.
     const isa::Decoded& d = decoded_[index];
     const uint32_t addr = h.reg[d.rs1] + uint32_t(d.imm);
-    return addr >= trax::map::kLocalTop - trax::map::kStackGuard ||
-           (privacy == Privacy::Load && memory_.in_read_only_global(addr));
+    return in_local_store(addr) || (privacy == Privacy::Load && memory_.in_read_only_global(addr));
+}
+
+inline bool Machine::next_is_private(uint32_t id) const {
+    const Thread& t = threads_[id];
+    if (t.state != ThreadState::Running) return false;
+    const uint32_t pc = t.hart.pc;
+    const uint32_t index = std::rotr(pc - entry_code_.base, 2);
+    if (index < entry_code_.words)
+        return is_private(t.hart, index, entry_code_.words, entry_code_.first);
+    const CodeRange* range = code_range_at(pc);
+    return range && is_private(t.hart, (pc - range->base) / 4, range->words, range->first);
 }
 
 }  // namespace tpsim::core

@@ -9,6 +9,7 @@
 
 #include "sim/core/error.hpp"
 #include "sim/core/fault.hpp"
+#include "sim/core/host_threads.hpp"
 #include "sim/core/machine.hpp"
 #include "sim/core/stack_bound.hpp"
 #include "sim/render/native_twin.hpp"
@@ -30,7 +31,7 @@ KernelRun run_functional(const core::Program& program, image::MemoryImage& image
                          uint64_t max_item_instructions) {
     const auto machine = timing::make_machine(program, image.words, image.read_only_bytes(), chip,
                                               max_instructions, max_item_instructions);
-    machine->run();
+    machine->run(core::host_threads());
     std::memcpy(image.words.data(), machine->memory().global().data(), image.bytes());
     return {InstructionCounts::of(machine->counters()), machine->output()};
 }

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "sim/core/error.hpp"
+#include "sim/core/host_threads.hpp"
 
 namespace tpsim::render {
 
@@ -21,6 +22,7 @@ std::shared_ptr<TimingRun> run_timing(const core::Program& program, image::Memor
     layout.profile = options.profile;
     run->chip = std::make_unique<timing::Chip>(chip, *run->source, layout);
     timing::Chip& model = *run->chip;
+    model.use_host_threads(core::host_threads());
     stats::Registry chip_stats;
     model.register_stats(chip_stats);
     const auto report = [&] {

@@ -1,6 +1,7 @@
 #include "sim/timing/chip.hpp"
 
 #include "kernel/memory_map.hpp"
+#include "sim/core/ordered_turns.hpp"
 #include "sim/timing/bits.hpp"
 #include "sim/timing/machine_source.hpp"
 
@@ -9,8 +10,12 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <atomic>
+#include <barrier>
 #include <bit>
+#include <functional>
 #include <stdexcept>
+#include <thread>
 #include <utility>
 
 namespace tpsim::timing {
@@ -24,10 +29,6 @@ constexpr uint64_t kSyncWait = kNever - 1;
 constexpr uint64_t kDeadlockCycles = 1'000'000;
 constexpr size_t kPools = static_cast<size_t>(Pool::Count);
 constexpr size_t kStalls = static_cast<size_t>(Stall::Count);
-
-bool is_local(uint32_t addr) {
-    return addr >= trax::map::kLocalTop - trax::map::kStackGuard;
-}
 
 /// The longest a TP can sleep until a known cycle: an operand wait (at most the longest FU
 /// latency plus the local-store latency) or a branch bubble.
@@ -176,8 +177,30 @@ struct Chip::Tm {
     Cache l1;
     uint32_t rotation = 0;  // TP that goes first this cycle (fetch and L1 priority)
     uint32_t atomic_sequence = 0;
-    std::vector<AtomicRequest> atomics_out;  // sent this cycle, collected by the chip
+    // Sent to the global-register unit, in order; the shared parts take each one the cycle
+    // after it was sent.
+    std::deque<AtomicRequest> atomics_out;
     uint32_t running = 0;
+    uint64_t idle_from = kNever;  // first cycle with every thread exited
+    // Delivered before each window (Chip::deliver), received in the cycle they arrive: L2
+    // fills of L1 lines and global-register replies, each in the order the shared parts
+    // produced them.
+    struct Fill {
+        uint64_t cycle;
+        uint32_t line;
+    };
+    std::deque<Fill> fills;
+    std::deque<AtomicReply> replies;
+    // Work-item charges made in a window, added to the chip's costs after it.
+    struct ItemCharge {
+        uint32_t item;
+        uint64_t cycles, instructions;
+    };
+    std::vector<ItemCharge> charges;
+    // Deadlock detector: events (issues, replies) so far, and the window's first and last
+    // cycle with any.
+    uint64_t progress = 0;
+    uint64_t first_progress = kNever, last_progress = 0;
     // Visited by the cycle loop: not exited, not asleep (timed sleepers wait in the wheel,
     // reply-waits return through wake()).
     TpBits awake_tps;
@@ -194,7 +217,8 @@ struct Chip::Tm {
     TpBits wheel;
     Counters counters;
     std::vector<LevelTraffic> l1_traffic;  // by region
-    PcProfile* profile = nullptr;          // the chip's, when it profiles
+    PcProfile* profile = nullptr;          // its host thread's lane, when the chip profiles
+    PcCounters* outside_text = nullptr;    // ... and that lane's share of a pc outside the text
 };
 
 Chip::Chip(const ChipConfig& config, InstructionSource& source, const ChipLayout& layout)
@@ -246,24 +270,92 @@ Chip::Chip(const ChipConfig& config, InstructionSource& source, const ChipLayout
     for (uint32_t t = 0; t < config.chip.num_tms; ++t) {
         tms_.push_back(std::make_unique<Tm>(config, t, regions));
         tms_.back()->running = config.chip.tps_per_tm;
-        if (layout.profile) tms_.back()->profile = &profile_;
     }
     for (uint32_t g = 0; g < config.num_l2(); ++g)
         l2s_.emplace_back(config.l2, config.l2.write_combining_lines);
+    clocks_.resize(config.chip.num_tms);
+    // The lookahead: a TM's request reaches the shared parts at the earliest the cycle after
+    // it was sent, and what they send back arrives no sooner than an L2 hit's or a
+    // global-register reply's latency later; so the replies a TM receives in the next
+    // `lookahead_` cycles are decided before those cycles begin.
+    lookahead_ =
+        std::min<uint64_t>(config.l2.hit_latency,
+                           config.global_registers.latency + config.global_registers.link_latency);
+    use_host_threads(1);
+}
+
+/// The TMs' host threads: lane 0 is the calling thread, lanes 1.. wait for work between windows.
+struct Chip::HostThreads {
+    explicit HostThreads(uint32_t lanes) : turns(lanes), start(lanes), done(lanes) {
+        for (uint32_t lane = 1; lane < lanes; ++lane)
+            threads.emplace_back([this, lane] {
+                for (;;) {
+                    start.arrive_and_wait();
+                    if (stop) return;
+                    (*job)(lane);
+                    done.arrive_and_wait();
+                }
+            });
+    }
+    ~HostThreads() {
+        stop = true;
+        start.arrive_and_wait();
+        for (std::thread& t : threads)
+            t.join();
+    }
+    /// Runs job(lane) on every lane and returns when all are done; `job` must not throw.
+    void run(const std::function<void(uint32_t)>& work) {
+        job = &work;
+        start.arrive_and_wait();
+        work(0);
+        done.arrive_and_wait();
+    }
+
+    core::OrderedTurns turns;
+    // A lane that failed: where in the order, and what (the earliest is rethrown).
+    struct Failure {
+        uint64_t position = core::OrderedTurns::kDone;
+        std::exception_ptr error;
+    };
+    std::vector<Failure> failures = std::vector<Failure>(turns.lanes());
+    std::atomic<uint64_t> first_failure{core::OrderedTurns::kDone};
+    std::barrier<> start, done;
+    bool stop = false;
+    const std::function<void(uint32_t)>* job = nullptr;
+    std::vector<std::thread> threads;
+};
+
+void Chip::use_host_threads(uint32_t threads) {
+    const uint32_t lanes = std::clamp<uint32_t>(threads, 1, config_.chip.num_tms);
+    if (layout_.profile) collect();  // the lanes' counts so far go on in lane 0
+    host_threads_.reset();
+    if (lanes > 1) host_threads_ = std::make_unique<HostThreads>(lanes);
+    profile_lanes_.assign(layout_.profile ? lanes : 0, {});
+    for (ProfileLane& lane : profile_lanes_) {
+        lane.profile.text = layout_.text;
+        lane.profile.words.resize(profile_.words.size());
+    }
+    if (!profile_lanes_.empty()) profile_lanes_[0].profile.words = profile_.words;
+    for (auto& tm : tms_)
+        if (layout_.profile) {
+            ProfileLane& lane = profile_lanes_[tm->id % lanes];
+            tm->profile = &lane.profile;
+            tm->outside_text = &lane.outside_text;
+        }
 }
 
 Chip::Chip(const ChipConfig& config, MachineSource& source, const ChipLayout& layout)
     : Chip(config, static_cast<InstructionSource&>(source), layout) {
     run_cycles_ = &Chip::run_cycles<MachineSource>;
     warm_threads_ = &Chip::warm_threads<MachineSource>;
-    // During the tick of cycle `now`, cycles_ == now, so an instruction sees the cycle it is
-    // fetched (and executed) in.
+    // During TM t's tick of cycle `now`, clocks_[t] == now, so an instruction sees the cycle it
+    // is fetched (and executed) in.
     clocked_machine_ = &source.machine();
-    clocked_machine_->set_cycle_counter(&cycles_);
+    clocked_machine_->set_cycle_counters(&clocks_[0].now, sizeof(TmClock) / sizeof(uint64_t));
 }
 
 Chip::~Chip() {
-    if (clocked_machine_) clocked_machine_->set_cycle_counter(nullptr);
+    if (clocked_machine_) clocked_machine_->set_cycle_counters(nullptr, 0);
 }
 
 bool Chip::run_until(uint64_t cycle) {
@@ -278,7 +370,8 @@ bool Chip::quiescent() const {
         // A TP asleep until a reply still has a load or an atomic in flight.
         for (const Tm::Tp& tp : tm->tps)
             if (tp.wake_at == kNever) return false;
-        if (tm->l1.outstanding_misses() || !tm->l1.outbound().empty() || !tm->atomics_out.empty())
+        if (tm->l1.outstanding_misses() || !tm->l1.outbound().empty() || !tm->atomics_out.empty() ||
+            !tm->replies.empty())
             return false;
     }
     for (const Cache& l2 : l2s_)
@@ -298,6 +391,8 @@ bool Chip::drain() {
 }
 
 Chip::Warming Chip::warm(uint64_t instructions) {
+    for (TmClock& clock : clocks_)
+        clock.now = cycles_;
     return (this->*warm_threads_)(instructions);
 }
 
@@ -346,7 +441,7 @@ struct Chip::WarmingObserver {
     uint64_t waited = 0;  // cycles the thread's loads would wait below its L1 (roughly)
 
     void access(uint32_t addr, uint8_t, bool store) {
-        if (is_local(addr))
+        if (core::in_local_store(addr))
             tp.lowest_local = std::min(tp.lowest_local, addr);
         else
             waited += chip.warm_access(tm, addr, store);
@@ -422,17 +517,21 @@ uint64_t Chip::run(uint64_t max_cycles) {
     return cycles_;
 }
 
-bool Chip::busy() const {
+bool Chip::busy(uint64_t at) const {
+    // A global-register reply delivered to a TM but not received yet is still in flight.
     for (const auto& tm : tms_)
-        if (tm->running || tm->l1.outstanding_misses() || !tm->l1.outbound().empty()) return true;
+        if (tm->idle_from > at || tm->l1.outstanding_misses() || !tm->l1.outbound().empty() ||
+            !tm->replies.empty())
+            return true;
     for (const Cache& l2 : l2s_)
         if (l2.outstanding_misses() || !l2.outbound().empty()) return true;
     return !dram_.idle() || !global_registers_.idle();
 }
 
 bool Chip::drained() const {
-    return !busy() && std::none_of(l2s_.begin(), l2s_.end(),
-                                   [](const Cache& l2) { return l2.holds_combined_lines(); });
+    return !busy(cycles_) && std::none_of(l2s_.begin(), l2s_.end(), [](const Cache& l2) {
+        return l2.holds_combined_lines();
+    });
 }
 
 uint8_t Chip::region_of(uint32_t addr) const {
@@ -460,47 +559,168 @@ void Chip::collect() {
             local_store_high_water_ =
                 std::max<uint64_t>(local_store_high_water_, trax::map::kLocalTop - tp.lowest_local);
     }
+    if (!profile_lanes_.empty()) {
+        std::fill(profile_.words.begin(), profile_.words.end(), PcCounters{});
+        for (const ProfileLane& lane : profile_lanes_)
+            for (size_t w = 0; w < profile_.words.size(); ++w) {
+                PcCounters& sum = profile_.words[w];
+                const PcCounters& c = lane.profile.words[w];
+                sum.executions += c.executions;
+                for (size_t k = 0; k < kStalls; ++k)
+                    sum.stalls[k] += c.stalls[k];
+                sum.l1_misses += c.l1_misses;
+                sum.dram_bytes += c.dram_bytes;
+            }
+    }
 }
 
+// A window of cycles at a time: the TMs' ticks (on the host threads), then the shared parts'
+// ticks of the same cycles (docs/hardware-model.md, "Parallel simulation").
 template <class Source> bool Chip::run_cycles(uint64_t end) {
     // The constructor chose Source to be the source's own type.
     Source& source = static_cast<Source&>(source_);
-    for (uint64_t now = cycles_; now < end && !finished_; ++now) {
-        if (!busy()) {
-            // Every thread has exited: the write-combining buffers drain, then the chip is done.
-            bool drained_lines = false;
-            for (Cache& l2 : l2s_)
-                drained_lines |= l2.drain_write_buffer(now);
-            if (!drained_lines) {
-                finished_ = true;
-                break;
-            }
+    while (cycles_ < end && !finished_) {
+        const uint64_t first = cycles_;
+        const uint64_t window_end = std::min(end, first + lookahead_);
+        deliver(window_end);
+        tick_tms(first, window_end, source);
+        uint64_t first_progress = kNever, last_progress = 0;
+        for (auto& tm : tms_) {
+            for (const Tm::ItemCharge& c : tm->charges)
+                charge_item(c.item, c.cycles, c.instructions);
+            tm->charges.clear();
+            first_progress = std::min(first_progress, std::exchange(tm->first_progress, kNever));
+            last_progress = std::max(last_progress, std::exchange(tm->last_progress, 0));
         }
-        tick_shared(now);
-        // TMs of up to 64 TPs (one word per bit set) take a loop without word loops; the
-        // profile's bookkeeping is compiled in only where it is collected.
-        const bool one_word = config_.chip.tps_per_tm <= 64;
-        for (auto& tm : tms_)
-            if (layout_.profile)
-                one_word ? tick_tm<Source, 1, true>(*tm, now, source)
-                         : tick_tm<Source, 0, true>(*tm, now, source);
-            else
-                one_word ? tick_tm<Source, 1, false>(*tm, now, source)
-                         : tick_tm<Source, 0, false>(*tm, now, source);
-        cycles_ = now + 1;
-        if (progress_ != last_progress_) {
-            last_progress_ = progress_;
-            last_progress_cycle_ = now;
-        } else if (now - last_progress_cycle_ > kDeadlockCycles) {
+        shared_first_progress_ = kNever;
+        shared_last_progress_ = 0;
+        uint64_t now = first;
+        for (; now < window_end; ++now) {
+            if (!busy(now)) {
+                // Every thread has exited: the write-combining buffers drain, then the chip is
+                // done. (No TM has ticked this cycle: each stops when its last thread exits.)
+                bool drained_lines = false;
+                for (Cache& l2 : l2s_)
+                    drained_lines |= l2.drain_write_buffer(now);
+                if (!drained_lines) {
+                    finished_ = true;
+                    break;
+                }
+            }
+            // TMs whose threads have all exited still receive their fills and replies.
+            for (auto& tm : tms_)
+                if (tm->idle_from <= now) tm_cycle(*tm, now, source);
+            tick_shared(now);
+        }
+        cycles_ = now;
+        for (auto& tm : tms_) {
+            first_progress = std::min(first_progress, std::exchange(tm->first_progress, kNever));
+            last_progress = std::max(last_progress, std::exchange(tm->last_progress, 0));
+        }
+        first_progress = std::min(first_progress, shared_first_progress_);
+        last_progress = std::max(last_progress, shared_last_progress_);
+        // The first cycle the serial loop would have found without progress for too long.
+        const uint64_t stuck = last_progress_cycle_ + kDeadlockCycles + 1;
+        if (stuck < cycles_ && first_progress > stuck)
             throw std::runtime_error(fmt::format(
                 "timing: deadlock, nothing issued or returned for {} cycles (cycle {}); "
                 "this is a simulator bug, please report it with the config",
-                kDeadlockCycles, now));
-        }
+                kDeadlockCycles, stuck));
+        if (first_progress != kNever) last_progress_cycle_ = last_progress;
     }
     finished_ = finished_ || drained();
     collect();
     return finished_;
+}
+
+void Chip::deliver(uint64_t end) {
+    MemReply reply;
+    for (Cache& l2 : l2s_)
+        while (l2.pop_reply(end - 1, reply))
+            tms_[reply.request.source]->fills.push_back({reply.ready, reply.request.addr});
+    AtomicReply atomic;
+    while (global_registers_.pop_reply(end - 1, atomic))
+        tms_[atomic.request.tm]->replies.push_back(atomic);
+}
+
+template <class Source> void Chip::tick_tms(uint64_t first, uint64_t end, Source& source) {
+    if (!host_threads_) {
+        for (uint64_t now = first; now < end; ++now)
+            for (auto& tm : tms_)
+                if (tm->running != 0) tm_cycle(*tm, now, source);
+        return;
+    }
+    HostThreads& host = *host_threads_;
+    const uint32_t lanes = host.turns.lanes();
+    host.run([&](uint32_t lane) { tick_lane(lane, lanes, first, end, source); });
+    if (host.first_failure != core::OrderedTurns::kDone)
+        for (const HostThreads::Failure& failure : host.failures)
+            if (failure.position == host.first_failure) std::rethrow_exception(failure.error);
+}
+
+template <class Source>
+void Chip::tick_lane(uint32_t lane, uint32_t lanes, uint64_t first, uint64_t end, Source& source) {
+    HostThreads& host = *host_threads_;
+    const uint64_t tms = tms_.size();
+    uint64_t position = first * tms;
+    try {
+        for (uint64_t now = first; now < end; ++now)
+            for (uint64_t t = lane; t < tms; t += lanes) {
+                Tm& tm = *tms_[t];
+                if (tm.running == 0) continue;
+                position = now * tms + t;
+                host.turns.reach(lane, position);
+                tm_cycle(tm, now, source);
+            }
+        host.turns.reach(lane, end * tms);
+        return;
+    } catch (const core::OrderedTurns::Abandoned&) {
+    } catch (...) {
+        // What failed first in the order is what one host thread would have seen: wait until
+        // everything before it has happened, so that a fault reports the output printed so far.
+        host.turns.wait_turn(lane, position);
+        std::exception_ptr error = std::current_exception();
+        try {
+            throw;
+        } catch (const core::Fault& f) {
+            if (clocked_machine_)
+                error = std::make_exception_ptr(core::Fault(f.kind(), f.thread(), f.pc(), f.what(),
+                                                            clocked_machine_->output()));
+        } catch (...) {
+        }
+        host.failures[lane] = {position, error};
+        uint64_t earliest = host.first_failure.load();
+        while (position < earliest &&
+               !host.first_failure.compare_exchange_weak(earliest, position)) {
+        }
+    }
+    host.turns.reach(lane, core::OrderedTurns::kDone);
+}
+
+void Chip::wait_turn(const Tm& tm, uint64_t now) {
+    HostThreads& host = *host_threads_;
+    const uint32_t lanes = host.turns.lanes();
+    const uint64_t position = now * tms_.size() + tm.id;
+    host.turns.wait_turn(tm.id % lanes, position);
+    if (host.first_failure.load() < position) throw core::OrderedTurns::Abandoned{};
+}
+
+template <class Source> void Chip::tm_cycle(Tm& tm, uint64_t now, Source& source) {
+    clocks_[tm.id].now = now;
+    const uint64_t progress = tm.progress;
+    // TMs of up to 64 TPs (one word per bit set) take a loop without word loops; the
+    // profile's bookkeeping is compiled in only where it is collected.
+    const bool one_word = config_.chip.tps_per_tm <= 64;
+    if (layout_.profile)
+        one_word ? tick_tm<Source, 1, true>(tm, now, source)
+                 : tick_tm<Source, 0, true>(tm, now, source);
+    else
+        one_word ? tick_tm<Source, 1, false>(tm, now, source)
+                 : tick_tm<Source, 0, false>(tm, now, source);
+    if (tm.progress != progress) {
+        tm.first_progress = std::min(tm.first_progress, now);
+        tm.last_progress = now;
+    }
 }
 
 uint32_t Chip::running_threads() const {
@@ -510,18 +730,17 @@ uint32_t Chip::running_threads() const {
     return running;
 }
 
-// Shared parts, in a fixed order: replies DRAM -> L2 -> L1, then requests L1 -> L2 -> DRAM
-// (so a request reaches DRAM in the cycle it leaves L2), then the global registers. TMs are
-// always visited in id order, each TM's queue in FIFO order.
+// Shared parts, in a fixed order: DRAM -> L2 fills, then requests L1 -> L2 -> DRAM (so a
+// request reaches DRAM in the cycle it leaves L2), then the global registers. TMs are always
+// visited in id order, each TM's queue in FIFO order. (L2 -> L1 fills and global-register
+// replies reach the TMs through deliver().)
 void Chip::tick_shared(uint64_t now) {
     MemReply reply;
     while (dram_.pop_reply(now, reply)) {
         l2s_[reply.request.source].fill(now, reply.request.addr);
-        ++progress_;
+        shared_first_progress_ = std::min(shared_first_progress_, now);
+        shared_last_progress_ = now;
     }
-    for (Cache& l2 : l2s_)
-        while (l2.pop_reply(now, reply))
-            tms_[reply.request.source]->l1.fill(now, reply.request.addr);
 
     const uint32_t line_bytes = config_.l2.line_bytes;
     for (auto& tm : tms_) {
@@ -548,32 +767,22 @@ void Chip::tick_shared(uint64_t now) {
         }
     }
     dram_.tick(now);
+    PcProfile* profile = profile_lanes_.empty() ? nullptr : &profile_lanes_[0].profile;
     for (const MemRequest& served : dram_.served()) {
         LevelTraffic& t = dram_traffic_[served.region];
         ++(served.write ? t.writes : t.reads);
         t.payload_bytes += served.write ? served.bytes : line_bytes;
         t.moved_bytes += line_bytes;
         item_costs(served.item).dram_bytes += line_bytes;
-        if (PcCounters* pc = profile_.at(served.pc)) pc->dram_bytes += line_bytes;
+        if (profile)
+            if (PcCounters* pc = profile->at(served.pc)) pc->dram_bytes += line_bytes;
     }
     dram_.served().clear();
-    for (auto& tm : tms_) {
-        for (const AtomicRequest& a : tm->atomics_out)
-            global_registers_.submit(a);
-        tm->atomics_out.clear();
-    }
+    // Requests sent in an earlier cycle (the TMs have already ticked this one).
+    for (auto& tm : tms_)
+        for (auto& out = tm->atomics_out; !out.empty() && out.front().sent < now; out.pop_front())
+            global_registers_.submit(out.front());
     global_registers_.tick(now);
-    AtomicReply atomic;
-    while (global_registers_.pop_reply(now, atomic)) {
-        Tm& tm = *tms_[atomic.request.tm];
-        if (atomic.request.kind == GlobalRequest::Increment) [[likely]] {
-            tm.tps[atomic.request.tp].reg_ready[atomic.request.tag] = now;
-            tm.wake(atomic.request.tp, now);
-        } else {
-            tm.wake_from_sync(atomic.request.tp, now);
-        }
-        ++progress_;
-    }
 }
 
 void Chip::send_sync(Tm& tm, uint32_t i, const StepInfo& s, uint64_t now) {
@@ -596,14 +805,28 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
     const uint32_t n = static_cast<uint32_t>(tm.tps.size());
     // The profile's share of a stall or event: the instruction at `pc`.
     const auto profile_at = [&](uint32_t pc) -> PcCounters& {
-        PcCounters* counters = profile_.at(pc);
-        return counters ? *counters : outside_text_;
+        PcCounters* counters = tm.profile->at(pc);
+        return counters ? *counters : *tm.outside_text;
     };
+
+    // Receive: L2 fills, global-register replies, then the L1's replies.
+    for (; !tm.fills.empty() && tm.fills.front().cycle <= now; tm.fills.pop_front())
+        tm.l1.fill(now, tm.fills.front().line);
+    for (; !tm.replies.empty() && tm.replies.front().ready <= now; tm.replies.pop_front()) {
+        const AtomicRequest& atomic = tm.replies.front().request;
+        if (atomic.kind == GlobalRequest::Increment) [[likely]] {
+            tm.tps[atomic.tp].reg_ready[atomic.tag] = now;
+            tm.wake(atomic.tp, now);
+        } else {
+            tm.wake_from_sync(atomic.tp, now);
+        }
+        ++tm.progress;
+    }
     MemReply reply;
     while (tm.l1.pop_reply(now, reply)) {
         tm.tps[reply.request.source].reg_ready[reply.request.tag] = now;
         tm.wake(reply.request.source, now);
-        ++progress_;
+        ++tm.progress;
     }
     if (tm.running == 0) return;
 
@@ -631,11 +854,13 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
     // Every awake TP: fetch if it holds no instruction, check the scoreboard, request a unit.
     // Done in passes over bit sets, each pass a short loop with few data-dependent branches.
     // Only fetch depends on the order (I-cache banks, and the functional step, whose
-    // shared-memory effects must happen in fetch order): it goes in rotating order.
+    // shared-memory effects must happen in fetch order): it goes in rotating order. On several
+    // host threads, the first step that is not private waits for this TM's turn in the cycle.
     tm.wake_timed(now);
     Tm::Tp* const tps = tm.tps.data();
     const uint32_t first_thread = tm.id * n;
     auto& counters = tm.counters;
+    bool my_turn = !host_threads_;
     // Forced inline (GCC keeps a lambda called from two sites out of line): out of line, its
     // captures are reloaded through memory at every use.
     const auto fetch_part = [&](const RotatedPart& part) __attribute__((always_inline)) {
@@ -655,10 +880,14 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             const auto bit = static_cast<uint32_t>(std::countr_zero(bits));
             const uint32_t i = part.index(bit);
             Tm::Tp& tp = tps[i];
+            if (!my_turn && !source.next_is_private(first_thread + i)) [[unlikely]] {
+                wait_turn(tm, now);
+                my_turn = true;
+            }
             source.step(first_thread + i, tp.pending);
             tp.pending_pool = pool_of_[size_t(tp.pending.insn->fu)];
             const bool global_access =  // bitwise &: no branch on an unpredictable outcome
-                (tp.pending_pool == Pool::LoadStore) & !is_local(tp.pending.mem_address);
+                (tp.pending_pool == Pool::LoadStore) & !tp.pending.mem_local;
             needs_port |= uint64_t{global_access} << bit;
         }
         tm.needs_port_tps[w] |= part.back(needs_port);
@@ -739,7 +968,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
         const FuPool::Grants grants = tm.pools[p].arbitrate(now, tm.issuing_tps.data());
         counters.stalls[size_t(Stall::FuBusy)] += grants.denied;
         counters.instructions += grants.granted;
-        progress_ += grants.granted;
+        tm.progress += grants.granted;
     }
     for (uint32_t w = 0; w < words; ++w) {
         const uint64_t issuing = std::exchange(tm.issuing_tps[w], 0);
@@ -759,7 +988,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             ++counters.per_class[size_t(fu)];
             // atomicinc(0) hands out the next work item; it is the first instruction of it.
             if (fu == isa::FuClass::Atomic && d.imm == 0) [[unlikely]] {
-                charge_item(tp.item, now - tp.item_since, tp.item_instructions);
+                tm.charges.push_back({tp.item, now - tp.item_since, tp.item_instructions});
                 tp.item = s.atomic_result;
                 tp.item_since = now;
                 tp.item_instructions = 0;
@@ -774,7 +1003,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
                 } else {
                     send_sync(tm, i, s, now);
                 }
-            } else if (s.mem_bytes != 0 && is_local(s.mem_address)) {
+            } else if (s.mem_bytes != 0 && s.mem_local) {
                 tp.lowest_local = std::min(tp.lowest_local, s.mem_address);
                 ++(s.mem_store ? counters.local_stores : counters.local_loads);
                 counters.local_payload_bytes += s.mem_bytes;
@@ -793,8 +1022,8 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             }
             if (s.exited) {
                 clear_bit(tm.awake_tps, i);
-                --tm.running;
-                charge_item(tp.item, now + 1 - tp.item_since, tp.item_instructions);
+                if (--tm.running == 0) tm.idle_from = now + 1;
+                tm.charges.push_back({tp.item, now + 1 - tp.item_since, tp.item_instructions});
                 if (s.atomic_result != 0)  // the exit lets threads at the barrier go on
                     tm.atomics_out.push_back({now, tm.id, tm.atomic_sequence++, i, 0,
                                               GlobalRequest::Exit, s.atomic_result,

@@ -7,6 +7,15 @@
 // ready. Each TM touches only its own state; traffic to L2, DRAM and the global registers moves
 // through cycle-stamped queues processed in a fixed order (TM id, then FIFO order), so results
 // never depend on host scheduling.
+//
+// Parallel simulation (docs/hardware-model.md, "Parallel simulation"): the cycles run in windows
+// no longer than the shortest way back from the shared parts to a TM (the lookahead). In a
+// window, the TMs run on the host threads, each with the replies the shared parts had already
+// decided for it; then the shared parts (L2s, DRAM, global registers) run the window's cycles on
+// one thread, taking the TMs' requests in (cycle, TM, FIFO) order. An instruction that touches
+// state other threads can see executes in its turn of the order (cycle, TM, fetch order), as it
+// does when one host thread visits the TMs in id order: results never depend on the number of
+// host threads.
 #pragma once
 #include "isa/isa.hpp"
 #include "sim/core/machine.hpp"
@@ -38,6 +47,11 @@ public:
     virtual uint32_t next_pc(uint32_t thread) const = 0;
     /// Executes that instruction and reports it in `out` (every field written).
     virtual void step(uint32_t thread, StepInfo& out) = 0;
+    /// Whether step(thread) touches only the thread's own state (its registers, local store,
+    /// the read-only scene): such steps may run on any host thread at any moment. The others
+    /// (shared memory, atomics, synchronisation, printing, faults) run in the chip's fixed
+    /// order. The default is safe for any source: no step is private.
+    virtual bool next_is_private(uint32_t /*thread*/) const { return false; }
 };
 
 class MachineSource;  // machine_source.hpp
@@ -52,6 +66,10 @@ public:
     /// this chip's clock while the chip lives.
     Chip(const ChipConfig& config, MachineSource& source, const ChipLayout& layout = {});
     ~Chip();
+
+    /// Simulates the TMs on up to `threads` host threads (at most one per TM; 1: on the calling
+    /// thread only). Nothing the chip reports depends on it.
+    void use_host_threads(uint32_t threads);
 
     /// How often callers looping over run_until() usually report progress.
     static constexpr uint64_t kProgressInterval = 1 << 16;
@@ -109,6 +127,7 @@ public:
 private:
     struct Tm;
     struct WarmingObserver;
+    struct HostThreads;
     // The cycle loop is instantiated for the concrete MachineSource (its calls inline) and for
     // any other InstructionSource (tests' scripted sources); the constructor picks one.
     template <class Source> bool run_cycles(uint64_t end);
@@ -118,7 +137,9 @@ private:
     uint32_t warm_access(Tm& tm, uint32_t addr, bool store);
     /// No fetched instruction and no memory or atomic request in flight (drain()).
     bool quiescent() const;
-    bool busy() const;  // anything in flight except lines in write-combining buffers
+    /// Anything in flight at the start of cycle `at`, except lines in write-combining buffers
+    /// (a TM whose threads have all exited by then is idle).
+    bool busy(uint64_t at) const;
     bool drained() const;
     /// Index of the region holding `addr` in layout_.regions, or other_region_.
     uint8_t region_of(uint32_t addr) const;
@@ -133,7 +154,22 @@ private:
         costs.cycles += cycles;
         costs.instructions += instructions;
     }
+    /// The shared parts' work in cycle `now`: DRAM and L2 fills, the TMs' requests to the
+    /// L2s (and on to DRAM), the global-register unit. Runs after the TMs' ticks of `now`.
     void tick_shared(uint64_t now);
+    /// Before a window ending at cycle `end` (exclusive): the L2 fills and global-register
+    /// replies each TM receives in it, all decided before the window began (the lookahead).
+    void deliver(uint64_t end);
+    /// The TMs' cycles [first, end), on the host threads; returns the cycles processed.
+    template <class Source> void tick_tms(uint64_t first, uint64_t end, Source& source);
+    /// One host thread's share of tick_tms: the TMs lane, lane + lanes, ...
+    template <class Source>
+    void tick_lane(uint32_t lane, uint32_t lanes, uint64_t first, uint64_t end, Source& source);
+    /// One cycle of one TM: what it receives, then (while it has threads) its tick.
+    template <class Source> void tm_cycle(Tm& tm, uint64_t now, Source& source);
+    /// Waits until every TM simulated on another host thread has passed TM `tm`'s position in
+    /// cycle `now` (OrderedTurns), before a step that is not private.
+    void wait_turn(const Tm& tm, uint64_t now);
     /// A synchronisation instruction of TP i issues: its request goes to the global-register
     /// unit, and the TP sleeps until the reply. Cold: out of the issue loop.
     [[gnu::cold, gnu::noinline]] void send_sync(Tm& tm, uint32_t i, const StepInfo& s,
@@ -148,7 +184,14 @@ private:
     bool (Chip::*run_cycles_)(uint64_t end) = &Chip::run_cycles<InstructionSource>;
     Warming (Chip::*warm_threads_)(uint64_t instructions) = &Chip::warm_threads<InstructionSource>;
     bool fetching_ = true;                      // false while drain() empties the chip
-    core::Machine* clocked_machine_ = nullptr;  // reads cycles_ through its cycle CSRs
+    core::Machine* clocked_machine_ = nullptr;  // reads the TMs' clocks through its cycle CSRs
+    // The cycle each TM is simulating, for the cycle CSRs; own cache lines (written every tick).
+    struct alignas(64) TmClock {
+        uint64_t now = 0;
+    };
+    std::vector<TmClock> clocks_;
+    uint64_t lookahead_ = 1;                     // cycles per window (at least 1)
+    std::unique_ptr<HostThreads> host_threads_;  // none: every TM on the calling thread
     std::vector<std::unique_ptr<Tm>> tms_;
     std::vector<Cache> l2s_;
     Dram dram_;
@@ -157,8 +200,10 @@ private:
     std::array<uint32_t, size_t(Pool::Count)> latency_of_{};
     uint64_t cycles_ = 0;
     uint64_t warmed_instructions_ = 0;
-    uint64_t progress_ = 0;  // bumped whenever anything issues or returns
-    uint64_t last_progress_ = 0, last_progress_cycle_ = 0;  // for the deadlock detector
+    // The deadlock detector: the last cycle anything issued or returned, and in the shared
+    // parts' part of the current window, the first and last such cycle.
+    uint64_t last_progress_cycle_ = 0;
+    uint64_t shared_first_progress_ = 0, shared_last_progress_ = 0;
     bool finished_ = false;
     uint64_t local_store_high_water_ = 0;  // bytes, max over threads
     // Region lookup: the regions sorted by address, as [begin, end) and their layout index.
@@ -172,8 +217,14 @@ private:
     std::vector<LevelTraffic> l1_traffic_, l2_traffic_, dram_traffic_;
     uint64_t local_payload_bytes_ = 0;  // summed in collect()
     WorkItemCosts work_items_;
-    PcProfile profile_;
-    PcCounters outside_text_;  // takes the profile's share of a pc about to fault; never read
+    PcProfile profile_;  // the lanes' sum, in collect()
+    // Each host thread counts its TMs' profile in its own lane (lane 0 also takes the shared
+    // parts' share); outside_text takes the share of a pc about to fault and is never read.
+    struct ProfileLane {
+        PcProfile profile;
+        PcCounters outside_text;
+    };
+    std::vector<ProfileLane> profile_lanes_;
 };
 
 }  // namespace tpsim::timing

@@ -62,6 +62,13 @@ public:
 
     uint32_t next_pc(uint32_t thread) const override { return next_pc_[thread]; }
 
+    /// Records run ahead are private (executed already); so is the next instruction if the
+    /// machine says so. A fault waiting for its fetch is not: it must be raised in turn.
+    bool next_is_private(uint32_t thread) const override {
+        const Ahead& a = ahead_[thread];
+        return a.next < a.size || (!a.fault && machine_.next_is_private(thread));
+    }
+
     void step(uint32_t thread, StepInfo& out) override {
         Ahead& a = ahead_[thread];
         if (a.next == a.size) {

@@ -1,0 +1,51 @@
+// Turns in a fixed order for work spread over host threads (lanes): each lane walks through
+// increasing positions of one global order (e.g. cycle * TMs + TM) and publishes where it is;
+// an action that other lanes can observe (an atomic increment, a global store, a print) waits
+// until every other lane has moved past its position. Such actions then happen in the order of
+// their positions, whatever the host does, and each sees exactly the effects of the earlier
+// ones (the release/acquire on the positions orders the memory). Lanes never wait in a cycle:
+// the lane with the lowest position waits for no one.
+#pragma once
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <thread>
+
+namespace tpsim::core {
+
+class OrderedTurns {
+public:
+    /// Past every position: a lane that has finished (or stopped) waits for nothing more.
+    static constexpr uint64_t kDone = UINT64_MAX;
+
+    /// Thrown by a lane whose next action comes after another lane's failure: it stops there.
+    struct Abandoned {};
+
+    explicit OrderedTurns(uint32_t lanes) : lanes_(lanes), at_(new Position[lanes]) {}
+
+    uint32_t lanes() const { return lanes_; }
+    /// Lane `lane` has done everything before `position` (non-decreasing per lane).
+    void reach(uint32_t lane, uint64_t position) {
+        at_[lane].value.store(position, std::memory_order_release);
+    }
+    /// Returns once every other lane has reached a position after `position`.
+    void wait_turn(uint32_t lane, uint64_t position) const {
+        for (uint32_t other = 0; other < lanes_; ++other) {
+            if (other == lane) continue;
+            // Spin briefly (the other lane is usually a few steps behind), then yield: on a
+            // busy host the lane waited for may be descheduled.
+            for (uint32_t spins = 0; at_[other].value.load(std::memory_order_acquire) <= position;
+                 ++spins)
+                if (spins >= 64) std::this_thread::yield();
+        }
+    }
+
+private:
+    struct alignas(64) Position {  // own cache line: lanes write theirs at every step
+        std::atomic<uint64_t> value{0};
+    };
+    uint32_t lanes_;
+    std::unique_ptr<Position[]> at_;
+};
+
+}  // namespace tpsim::core

@@ -1,0 +1,182 @@
+// Parallel simulation: the cycle-level chip and the functional machine on 1, 2, 3 and 8 host
+// threads give the same statistics, images, profiles, per-pixel costs, kernel output and
+// faults, on chips of one TM, several, an odd count, and fewer TMs than host threads.
+#include <atomic>
+#include <cstring>
+#include <random>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <catch2/catch.hpp>
+
+#include "sim/core/error.hpp"
+#include "sim/core/fault.hpp"
+#include "sim/core/host_threads.hpp"
+#include "sim/core/ordered_turns.hpp"
+#include "sim/render/render.hpp"
+#include "sim/render/report.hpp"
+#include "sim/render/timing_run.hpp"
+#include "sim/stats/registry.hpp"
+
+using namespace tpsim;
+
+namespace {
+
+constexpr uint32_t kHostThreads[] = {1, 2, 3, 8};
+
+struct Shape {
+    uint32_t tms, tps;
+};
+
+/// Everything a run reports that must not depend on the host threads, as text.
+std::string everything(const render::RenderResult& r) {
+    std::ostringstream out;
+    stats::Registry all;
+    render::register_stats(r, all);
+    for (const stats::Entry& e : all.entries())
+        if (!e.name.starts_with("host/")) out << e.name << '=' << e.value() << '\n';
+    out << "output " << r.output.tagged() << " dropped " << r.output.dropped() << '\n';
+    out << "image";
+    for (uint32_t word : r.image.words)
+        out << ' ' << word;
+    out << '\n';
+    if (r.timing) {
+        const timing::WorkItemCosts& items = r.timing->chip->work_items();
+        for (const timing::WorkItemCounters& c : items.items)
+            out << c.cycles << ',' << c.instructions << ',' << c.dram_bytes << ' ';
+        out << "unassigned " << items.unassigned.cycles << ',' << items.unassigned.instructions
+            << ',' << items.unassigned.dram_bytes << '\n';
+        for (const timing::PcCounters& c : r.timing->chip->profile().words) {
+            out << c.executions << ',' << c.l1_misses << ',' << c.dram_bytes;
+            for (uint64_t stall : c.stalls)
+                out << ',' << stall;
+            out << ' ';
+        }
+    }
+    return out.str();
+}
+
+render::RenderOptions options(const char* kernel, render::Engine engine, Shape shape,
+                              uint32_t pixels) {
+    render::RenderOptions o;
+    o.scene = std::filesystem::path(TPSIM_SOURCE_DIR) / "scenes" / "cornell.toml";
+    o.kernel = std::filesystem::path(TPSIM_KERNEL_DIR) / (std::string(kernel) + ".elf");
+    o.engine = engine;
+    o.image_width = o.image_height = pixels;
+    o.chip.chip.num_tms = shape.tms;
+    o.chip.chip.tps_per_tm = shape.tps;
+    o.chip.chip.tms_per_l2 = std::min(shape.tms, 2u);
+    return o;
+}
+
+/// Runs `o` on each host-thread count; every run must report what the first did.
+void check_same_for_any_host_threads(const render::RenderOptions& o) {
+    std::string first;
+    for (uint32_t threads : kHostThreads) {
+        INFO("host threads " << threads);
+        core::set_host_threads(threads);
+        const std::string now = everything(render::render(o));
+        if (first.empty())
+            first = now;
+        else
+            CHECK(now == first);  // (not printed: megabytes)
+    }
+}
+
+/// The fault `o` ends with: its message and the output before it.
+std::string fault_of(const render::RenderOptions& o) {
+    try {
+        render::render(o);
+    } catch (const core::Fault& f) {
+        return std::string(f.what()) + "\n" + f.output().tagged();
+    }
+    return "no fault";
+}
+
+}  // namespace
+
+TEST_CASE("ordered turns: actions at increasing positions run in position order on any lanes",
+          "[parallel]") {
+    // Each lane owns the positions p with p % lanes == lane; at a random subset of its
+    // positions it appends p to a plain vector in its turn. The vector must come out sorted,
+    // whatever the host does.
+    for (uint32_t lanes : {2u, 3u, 8u}) {
+        INFO(lanes << " lanes");
+        core::OrderedTurns turns(lanes);
+        constexpr uint64_t kPositions = 200'000;
+        std::vector<uint64_t> log;
+        std::vector<std::thread> threads;
+        for (uint32_t lane = 0; lane < lanes; ++lane)
+            threads.emplace_back([&, lane] {
+                std::mt19937 random(lane);
+                for (uint64_t p = lane; p < kPositions; p += lanes) {
+                    turns.reach(lane, p);
+                    if (random() % 4 == 0) {
+                        turns.wait_turn(lane, p);
+                        log.push_back(p);
+                    }
+                }
+                turns.reach(lane, core::OrderedTurns::kDone);
+            });
+        for (std::thread& t : threads)
+            t.join();
+        CHECK(log.size() > kPositions / 5);
+        CHECK(std::is_sorted(log.begin(), log.end()));
+    }
+}
+
+TEST_CASE("parallel: the tracer on the cycle-level chip is the same on any host threads",
+          "[parallel]") {
+    // One TM; four; an odd count (3 TMs of 5 TPs); and 2 TMs, fewer than 3 or 8 host threads.
+    for (const Shape shape : {Shape{1, 8}, Shape{4, 8}, Shape{3, 5}, Shape{2, 16}}) {
+        INFO(shape.tms << " TMs x " << shape.tps << " TPs");
+        render::RenderOptions o = options("tracer", render::Engine::timing, shape, 16);
+        o.profile = shape.tms == 4;
+        check_same_for_any_host_threads(o);
+    }
+}
+
+TEST_CASE("parallel: atomics, racing shared loads and stores, barriers, semaphores and prints "
+          "are the same on any host threads",
+          "[parallel]") {
+    for (const char* kernel :
+         {"unlocked_counter", "semaphore_counter", "barrier_neighbour", "print_order"})
+        for (const render::Engine engine : {render::Engine::timing, render::Engine::functional})
+            for (const Shape shape : {Shape{1, 4}, Shape{4, 3}, Shape{3, 5}}) {
+                INFO(kernel << (engine == render::Engine::timing ? " cycle-level " : " functional ")
+                            << shape.tms << " TMs x " << shape.tps << " TPs");
+                check_same_for_any_host_threads(options(kernel, engine, shape, 8));
+            }
+}
+
+TEST_CASE("parallel: a fault reports the same thread and output on any host threads",
+          "[parallel]") {
+    for (const render::Engine engine : {render::Engine::timing, render::Engine::functional})
+        for (const Shape shape : {Shape{4, 8}, Shape{3, 5}}) {
+            INFO((engine == render::Engine::timing ? "cycle-level " : "functional ")
+                 << shape.tms << " TMs x " << shape.tps << " TPs");
+            const render::RenderOptions o = options("fault_race", engine, shape, 8);
+            std::string first;
+            for (uint32_t threads : kHostThreads) {
+                INFO("host threads " << threads);
+                core::set_host_threads(threads);
+                const std::string fault = fault_of(o);
+                CHECK(fault.find("is not an RV32IMF instruction") != std::string::npos);
+                if (first.empty())
+                    first = fault;
+                else
+                    CHECK(fault == first);
+            }
+        }
+}
+
+TEST_CASE("parallel: sampled simulation is the same on any host threads", "[parallel]") {
+    render::RenderOptions o = options("tracer", render::Engine::timing, Shape{4, 8}, 32);
+    o.sampling = render::SamplingOptions{};
+    o.sampling->rate = 0.2;
+    o.sampling->unit_cycles = 500;
+    o.sampling->warmup_cycles = 200;
+    check_same_for_any_host_threads(o);
+}
