@@ -152,13 +152,13 @@ struct NoTurn {
 
 }  // namespace
 
-template <class Turn> void Machine::run_quantum(uint32_t id, uint64_t budget, Turn&& turn) {
+template <class Turn>
+void Machine::run_quantum(uint32_t id, uint64_t budget, Counters& counters, Turn&& turn) {
     // Until its turn, a quantum on several host threads checks each instruction for privacy.
     bool my_turn = std::is_same_v<std::decay_t<Turn>, NoTurn>;
     Thread& t = threads_[id];
     isa::Hart& h = t.hart;
     ThreadEnv<false> env(*this, id);
-    Counters& counters = counters_of(id);
     uint64_t* per_op = counters.per_op.data();
     uint64_t done = 0;
     uint32_t pc = h.pc;
@@ -222,7 +222,7 @@ Counters Machine::counters() const {
 }
 
 void Machine::run(uint32_t host_threads) {
-    const auto lanes = uint32_t(std::min<size_t>(host_threads, counter_lanes_.size()));
+    const uint32_t lanes = std::min(host_threads, thread_count());
     if (lanes > 1) return run_lanes(lanes);
     // Waiting threads are passed over; one that goes on runs again in its turn. The loop ends
     // when no thread is left running: suspend() and exited() report a deadlock before then.
@@ -232,17 +232,18 @@ void Machine::run(uint32_t host_threads) {
             if (t.state != ThreadState::Running) continue;
             const uint64_t left = instructions_left(t);
             if (left == 0) limit_fault(id);
-            run_quantum(id, std::min<uint64_t>(left, config_.quantum), NoTurn{});
+            run_quantum(id, std::min<uint64_t>(left, config_.quantum), counters_of(id), NoTurn{});
         }
 }
 
-// run()'s rounds on `lanes` host threads: lane l takes the threads of TMs l, l + lanes, ...
+// run()'s rounds on `lanes` host threads: lane l takes threads l, l + lanes, ...
 // Thread `id`'s quantum in round r has position r * threads + id in the order of run()'s
 // single loop; what it does that others can see waits for that turn (OrderedTurns).
 void Machine::run_lanes(uint32_t lanes) {
     OrderedTurns turns(lanes);
     const uint64_t threads = thread_count();
-    const uint32_t per_tm = config_.threads_per_tm;
+    // Each lane counts in its own lane of counters, added to the TM lanes' at the end.
+    std::vector<CounterLane> counters(lanes);
     bool more_rounds = running_threads_ != 0;
     // Between rounds, one look at running_threads_ decides for every lane.
     std::atomic<uint64_t> first_failure{OrderedTurns::kDone};
@@ -257,31 +258,30 @@ void Machine::run_lanes(uint32_t lanes) {
         uint64_t position = 0;
         try {
             for (uint64_t round = 0; more_rounds; ++round) {
-                for (uint32_t tm = lane; tm * per_tm < threads; tm += lanes)
-                    for (uint32_t id = tm * per_tm;
-                         id < std::min<uint64_t>(threads, (tm + 1) * per_tm); ++id) {
-                        Thread& t = threads_[id];
-                        position = round * threads + id;
-                        turns.reach(lane, position);
-                        const auto wait_turn = [&] {
-                            turns.wait_turn(lane, position);
-                            if (first_failure.load() < position) throw OrderedTurns::Abandoned{};
-                        };
-                        // Only this lane runs the thread, but a waiting thread is let go by
-                        // another's instruction: its state is read in turn.
-                        if (waiting[id]) {
-                            wait_turn();
-                            waiting[id] = t.state == ThreadState::Waiting;
-                        }
-                        if (t.state != ThreadState::Running) continue;
-                        const uint64_t left = instructions_left(t);
-                        if (left == 0) {
-                            wait_turn();
-                            limit_fault(id);
-                        }
-                        run_quantum(id, std::min<uint64_t>(left, config_.quantum), wait_turn);
+                for (uint32_t id = lane; id < threads; id += lanes) {
+                    Thread& t = threads_[id];
+                    position = round * threads + id;
+                    turns.reach(lane, position);
+                    const auto wait_turn = [&] {
+                        turns.wait_turn(lane, position);
+                        if (first_failure.load() < position) throw OrderedTurns::Abandoned{};
+                    };
+                    // Only this lane runs the thread, but a waiting thread is let go by
+                    // another's instruction: its state is read in turn.
+                    if (waiting[id]) {
+                        wait_turn();
                         waiting[id] = t.state == ThreadState::Waiting;
                     }
+                    if (t.state != ThreadState::Running) continue;
+                    const uint64_t left = instructions_left(t);
+                    if (left == 0) {
+                        wait_turn();
+                        limit_fault(id);
+                    }
+                    run_quantum(id, std::min<uint64_t>(left, config_.quantum),
+                                counters[lane].counters, wait_turn);
+                    waiting[id] = t.state == ThreadState::Waiting;
+                }
                 turns.reach(lane, (round + 1) * threads);
                 round_end.arrive_and_wait();
             }
@@ -316,6 +316,12 @@ void Machine::run_lanes(uint32_t lanes) {
     lane_work(0);
     for (std::thread& helper : helpers)
         helper.join();
+    for (const CounterLane& lane : counters) {
+        Counters& sum = counter_lanes_[0].counters;
+        sum.instructions += lane.counters.instructions;
+        for (size_t op = 0; op < sum.per_op.size(); ++op)
+            sum.per_op[op] += lane.counters.per_op[op];
+    }
     if (first_failure.load() == OrderedTurns::kDone) return;
     for (uint32_t lane = 0; lane < lanes; ++lane)
         if (failed_at[lane] == first_failure.load()) std::rethrow_exception(failures[lane]);

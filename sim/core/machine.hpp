@@ -75,13 +75,13 @@ struct StepRecord {
     /// chip needs to time them (see Machine::barrier and the semaphore functions).
     uint32_t atomic_result = 0;
     const isa::Decoded* insn = nullptr;  ///< its pre-decoded form (registers, FU class)
-    uint32_t mem_address = 0;            ///< effective address when mem_bytes != 0
-    uint8_t mem_bytes = 0;               ///< access size; 0 = no memory access
-    bool mem_store : 1 = false;
-    /// The access is to the thread's local store (in_local_store): no cache, no traffic.
-    bool mem_local : 1 = false;
-    bool taken : 1 = false;   ///< control left the fall-through path (branch, jump, trap)
-    bool exited : 1 = false;  ///< the instruction ended the thread
+    /// Effective address when mem_bytes != 0 (in the thread's own local store when
+    /// in_local_store(mem_address): no cache, no traffic).
+    uint32_t mem_address = 0;
+    uint8_t mem_bytes = 0;  ///< access size; 0 = no memory access
+    bool mem_store = false;
+    bool taken = false;   ///< control left the fall-through path (branch, jump, trap)
+    bool exited = false;  ///< the instruction ended the thread
 };
 static_assert(sizeof(StepRecord) == 24, "the timing model buffers 128 per thread");
 
@@ -102,9 +102,9 @@ public:
     /// Runs every thread to its exit, round-robin by thread id in fixed quanta (a waiting thread
     /// is passed over until it may go on), so results never depend on anything but the program
     /// and the config. Throws Fault on the first guest fault, a deadlock included. On several
-    /// host threads (each takes the threads of every host_threads-th TM), instructions that are
-    /// not private run in the turn (round, thread) they have in that order, so nothing depends
-    /// on the number.
+    /// host threads (host thread h takes threads h, h + host_threads, ...), instructions that
+    /// are not private run in the turn (round, thread) they have in that order, so nothing
+    /// depends on the number.
     void run(uint32_t host_threads = 1);
 
     /// Executes one instruction of a running thread and reports what it did. Throws Fault.
@@ -165,9 +165,10 @@ public:
 private:
     template <bool kRecord, class Observer> friend class ThreadEnv;
 
-    /// Runs up to `budget` instructions of thread `id`. `turn` is called before the first one
-    /// that is not private (and nothing else is checked) unless it is a NoTurn.
-    template <class Turn> void run_quantum(uint32_t id, uint64_t budget, Turn&& turn);
+    /// Runs up to `budget` instructions of thread `id`, counting them in `counters`. `turn` is
+    /// called before the first one that is not private (nothing is checked for a NoTurn).
+    template <class Turn>
+    void run_quantum(uint32_t id, uint64_t budget, Counters& counters, Turn&& turn);
     void run_lanes(uint32_t lanes);
     /// The code range holding the aligned pc, or nullptr (a fetch fault). Cold: the run loops
     /// keep the current range in locals and ask only when the pc leaves it.

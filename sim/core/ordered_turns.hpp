@@ -32,15 +32,17 @@ public:
     void wait_turn(uint32_t lane, uint64_t position) const {
         for (uint32_t other = 0; other < lanes_; ++other) {
             if (other == lane) continue;
-            // Spin briefly (the other lane is usually a few steps behind), then yield: on a
-            // busy host the lane waited for may be descheduled.
+            // Spin (the other lane is usually a few steps behind), then yield: on a busy host
+            // the lane waited for may be descheduled.
             for (uint32_t spins = 0; at_[other].value.load(std::memory_order_acquire) <= position;
                  ++spins)
-                if (spins >= 64) std::this_thread::yield();
+                if (spins >= kSpins) std::this_thread::yield();
         }
     }
 
 private:
+    // Spins (a few microseconds) before yielding: a turn is usually near.
+    static constexpr uint32_t kSpins = 4096;
     struct alignas(64) Position {  // own cache line: lanes write theirs at every step
         std::atomic<uint64_t> value{0};
     };

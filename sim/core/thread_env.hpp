@@ -131,7 +131,6 @@ private:
         record_->mem_address = addr;
         record_->mem_bytes = bytes;
         record_->mem_store = store;
-        record_->mem_local = in_local_store(addr);
     }
 
     Machine& machine_;
@@ -212,7 +211,6 @@ private:
         StepRecord& record = out[n++];
         record.mem_bytes = 0;
         record.mem_store = false;
-        record.mem_local = false;
         record.taken = true;
     } catch (...) {
         count();

@@ -142,6 +142,27 @@ struct Chip::Tm {
                 pc->stalls[size_t(Stall::Sync)] += waited;
         tp.wake_at = now;
     }
+    /// Start of cycle `now`: L2 fills, global-register replies, then the L1's replies.
+    void receive(uint64_t now) {
+        for (; !fills.empty() && fills.front().cycle <= now; fills.pop_front())
+            l1.fill(now, fills.front().line);
+        for (; !replies.empty() && replies.front().ready <= now; replies.pop_front()) {
+            const AtomicRequest& atomic = replies.front().request;
+            if (atomic.kind == GlobalRequest::Increment) [[likely]] {
+                tps[atomic.tp].reg_ready[atomic.tag] = now;
+                wake(atomic.tp, now);
+            } else {
+                wake_from_sync(atomic.tp, now);
+            }
+            ++progress;
+        }
+        MemReply reply;
+        while (l1.pop_reply(now, reply)) {
+            tps[reply.request.source].reg_ready[reply.request.tag] = now;
+            wake(reply.request.source, now);
+            ++progress;
+        }
+    }
     /// TP i leaves the awake set until cycle `at` (> now), when the wheel puts it back. A
     /// sleep longer than the wheel (configs with huge latencies) waits in the wheel's last slot
     /// and is put back to sleep by wake_timed.
@@ -153,7 +174,7 @@ struct Chip::Tm {
         set_bit(wheel, uint32_t(slot) * 64 * words + i);
     }
     /// Start of cycle `now`: the TPs whose timed sleep ends join the awake set.
-    void wake_timed(uint64_t now) {
+    [[gnu::always_inline]] void wake_timed(uint64_t now) {
         uint64_t* slot = &wheel[(now & (wheel_slots - 1)) * words];
         for (uint32_t w = 0; w < words; ++w) {
             uint64_t due = std::exchange(slot[w], 0);
@@ -304,6 +325,7 @@ struct Chip::HostThreads {
             t.join();
     }
     /// Runs job(lane) on every lane and returns when all are done; `job` must not throw.
+    /// Between its windows, job calls window_done.arrive_and_wait(), which runs `between`.
     void run(const std::function<void(uint32_t)>& work) {
         job = &work;
         start.arrive_and_wait();
@@ -320,6 +342,12 @@ struct Chip::HostThreads {
     std::vector<Failure> failures = std::vector<Failure>(turns.lanes());
     std::atomic<uint64_t> first_failure{core::OrderedTurns::kDone};
     std::barrier<> start, done;
+    std::function<void()> between;  // must not throw
+    struct Between {
+        HostThreads* host;
+        void operator()() noexcept { host->between(); }
+    };
+    std::barrier<Between> window_done{turns.lanes(), Between{this}};
     bool stop = false;
     const std::function<void(uint32_t)>* job = nullptr;
     std::vector<std::thread> threads;
@@ -579,11 +607,66 @@ void Chip::collect() {
 template <class Source> bool Chip::run_cycles(uint64_t end) {
     // The constructor chose Source to be the source's own type.
     Source& source = static_cast<Source&>(source_);
-    while (cycles_ < end && !finished_) {
-        const uint64_t first = cycles_;
-        const uint64_t window_end = std::min(end, first + lookahead_);
-        deliver(window_end);
-        tick_tms(first, window_end, source);
+    // A short stretch (drain() runs one cycle at a time) is not worth waking the host threads;
+    // either way gives the same result.
+    constexpr uint64_t kShortestParallelRun = 256;
+    if (host_threads_ && end >= cycles_ + kShortestParallelRun) {
+        run_windows_in_parallel(end, source);
+    } else {
+        while (cycles_ < end && !finished_) {
+            const uint64_t first = cycles_;
+            const uint64_t window_end = std::min(end, first + lookahead_);
+            deliver(window_end);
+            for (uint64_t now = first; now < window_end; ++now)
+                for (auto& tm : tms_)
+                    if (tm->running != 0) tm_cycle(*tm, now, source);
+            shared_window(first, window_end, source);
+        }
+    }
+    finished_ = finished_ || drained();
+    collect();
+    return finished_;
+}
+
+template <class Source> void Chip::run_windows_in_parallel(uint64_t end, Source& source) {
+    HostThreads& host = *host_threads_;
+    const uint32_t lanes = host.turns.lanes();
+    uint64_t first = cycles_, window_end = std::min(end, first + lookahead_);
+    bool more = cycles_ < end && !finished_;
+    if (more) deliver(window_end);
+    std::exception_ptr error;
+    // Between two windows, on one host thread while the others wait: the shared parts' share
+    // of the window just simulated, then the next window's deliveries.
+    host.between = [&] {
+        try {
+            if (host.first_failure != core::OrderedTurns::kDone) {
+                for (const HostThreads::Failure& failure : host.failures)
+                    if (failure.position == host.first_failure) error = failure.error;
+                more = false;
+                return;
+            }
+            shared_window(first, window_end, source);
+            first = cycles_;
+            window_end = std::min(end, first + lookahead_);
+            more = cycles_ < end && !finished_;
+            if (more) deliver(window_end);
+        } catch (...) {
+            error = std::current_exception();
+            more = false;
+        }
+    };
+    host.run([&](uint32_t lane) {
+        while (more) {
+            tick_lane(lane, lanes, first, window_end, source);
+            host.window_done.arrive_and_wait();
+        }
+    });
+    if (error) std::rethrow_exception(error);
+}
+
+template <class Source>
+void Chip::shared_window(uint64_t first, uint64_t window_end, Source& source) {
+    {
         uint64_t first_progress = kNever, last_progress = 0;
         for (auto& tm : tms_) {
             for (const Tm::ItemCharge& c : tm->charges)
@@ -628,9 +711,6 @@ template <class Source> bool Chip::run_cycles(uint64_t end) {
                 kDeadlockCycles, stuck));
         if (first_progress != kNever) last_progress_cycle_ = last_progress;
     }
-    finished_ = finished_ || drained();
-    collect();
-    return finished_;
 }
 
 void Chip::deliver(uint64_t end) {
@@ -641,21 +721,6 @@ void Chip::deliver(uint64_t end) {
     AtomicReply atomic;
     while (global_registers_.pop_reply(end - 1, atomic))
         tms_[atomic.request.tm]->replies.push_back(atomic);
-}
-
-template <class Source> void Chip::tick_tms(uint64_t first, uint64_t end, Source& source) {
-    if (!host_threads_) {
-        for (uint64_t now = first; now < end; ++now)
-            for (auto& tm : tms_)
-                if (tm->running != 0) tm_cycle(*tm, now, source);
-        return;
-    }
-    HostThreads& host = *host_threads_;
-    const uint32_t lanes = host.turns.lanes();
-    host.run([&](uint32_t lane) { tick_lane(lane, lanes, first, end, source); });
-    if (host.first_failure != core::OrderedTurns::kDone)
-        for (const HostThreads::Failure& failure : host.failures)
-            if (failure.position == host.first_failure) std::rethrow_exception(failure.error);
 }
 
 template <class Source>
@@ -708,10 +773,13 @@ void Chip::wait_turn(const Tm& tm, uint64_t now) {
 template <class Source> void Chip::tm_cycle(Tm& tm, uint64_t now, Source& source) {
     clocks_[tm.id].now = now;
     const uint64_t progress = tm.progress;
+    tm.receive(now);
     // TMs of up to 64 TPs (one word per bit set) take a loop without word loops; the
     // profile's bookkeeping is compiled in only where it is collected.
     const bool one_word = config_.chip.tps_per_tm <= 64;
-    if (layout_.profile)
+    if (tm.running == 0)
+        ;  // every thread has exited: it only receives
+    else if (layout_.profile)
         one_word ? tick_tm<Source, 1, true>(tm, now, source)
                  : tick_tm<Source, 0, true>(tm, now, source);
     else
@@ -809,27 +877,6 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
         return counters ? *counters : *tm.outside_text;
     };
 
-    // Receive: L2 fills, global-register replies, then the L1's replies.
-    for (; !tm.fills.empty() && tm.fills.front().cycle <= now; tm.fills.pop_front())
-        tm.l1.fill(now, tm.fills.front().line);
-    for (; !tm.replies.empty() && tm.replies.front().ready <= now; tm.replies.pop_front()) {
-        const AtomicRequest& atomic = tm.replies.front().request;
-        if (atomic.kind == GlobalRequest::Increment) [[likely]] {
-            tm.tps[atomic.tp].reg_ready[atomic.tag] = now;
-            tm.wake(atomic.tp, now);
-        } else {
-            tm.wake_from_sync(atomic.tp, now);
-        }
-        ++tm.progress;
-    }
-    MemReply reply;
-    while (tm.l1.pop_reply(now, reply)) {
-        tm.tps[reply.request.source].reg_ready[reply.request.tag] = now;
-        tm.wake(reply.request.source, now);
-        ++tm.progress;
-    }
-    if (tm.running == 0) return;
-
     // Granted loads/stores take their L1 bank in rotating order.
     for_each_rotated_part(words, tm.rotation, [&](const RotatedPart& part) {
         uint64_t accessed = 0;
@@ -887,7 +934,8 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             source.step(first_thread + i, tp.pending);
             tp.pending_pool = pool_of_[size_t(tp.pending.insn->fu)];
             const bool global_access =  // bitwise &: no branch on an unpredictable outcome
-                (tp.pending_pool == Pool::LoadStore) & !tp.pending.mem_local;
+                (tp.pending_pool == Pool::LoadStore) &
+                !core::in_local_store(tp.pending.mem_address);
             needs_port |= uint64_t{global_access} << bit;
         }
         tm.needs_port_tps[w] |= part.back(needs_port);
@@ -1003,7 +1051,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
                 } else {
                     send_sync(tm, i, s, now);
                 }
-            } else if (s.mem_bytes != 0 && s.mem_local) {
+            } else if (s.mem_bytes != 0 && core::in_local_store(s.mem_address)) {
                 tp.lowest_local = std::min(tp.lowest_local, s.mem_address);
                 ++(s.mem_store ? counters.local_stores : counters.local_loads);
                 counters.local_payload_bytes += s.mem_bytes;

@@ -160,8 +160,13 @@ private:
     /// Before a window ending at cycle `end` (exclusive): the L2 fills and global-register
     /// replies each TM receives in it, all decided before the window began (the lookahead).
     void deliver(uint64_t end);
-    /// The TMs' cycles [first, end), on the host threads; returns the cycles processed.
-    template <class Source> void tick_tms(uint64_t first, uint64_t end, Source& source);
+    /// run_cycles() on the host threads: windows of TM ticks on every lane, each followed by
+    /// shared_window() on one of them.
+    template <class Source> void run_windows_in_parallel(uint64_t end, Source& source);
+    /// After the TMs' ticks of cycles [first, window_end): their work-item charges, the shared
+    /// parts' ticks (and those of TMs whose threads have all exited) until the window's end or
+    /// the chip's, the deadlock detector.
+    template <class Source> void shared_window(uint64_t first, uint64_t window_end, Source& source);
     /// One host thread's share of tick_tms: the TMs lane, lane + lanes, ...
     template <class Source>
     void tick_lane(uint32_t lane, uint32_t lanes, uint64_t first, uint64_t end, Source& source);

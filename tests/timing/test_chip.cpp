@@ -40,7 +40,6 @@ public:
             s.mem_address = mem_address;
             s.mem_bytes = 4;
             s.mem_store = fu == isa::FuClass::Store;
-            s.mem_local = tpsim::core::in_local_store(mem_address);
         }
         s.taken = taken;
         trace_[thread].push_back(s);
