@@ -41,8 +41,9 @@ public:
     }
 
 private:
-    // Spins (a few microseconds) before yielding: a turn is usually near.
-    static constexpr uint32_t kSpins = 4096;
+    // Spins briefly before yielding: on an idle host the yield returns at once, on a busy one
+    // the thread waited for may need this core.
+    static constexpr uint32_t kSpins = 64;
     struct alignas(64) Position {  // own cache line: lanes write theirs at every step
         std::atomic<uint64_t> value{0};
     };

@@ -630,6 +630,11 @@ template <class Source> bool Chip::run_cycles(uint64_t end) {
 
 template <class Source> void Chip::run_windows_in_parallel(uint64_t end, Source& source) {
     HostThreads& host = *host_threads_;
+    windows_in_parallel_ = true;
+    struct Serial {
+        bool& parallel;
+        ~Serial() { parallel = false; }
+    } serial_after{windows_in_parallel_};
     const uint32_t lanes = host.turns.lanes();
     uint64_t first = cycles_, window_end = std::min(end, first + lookahead_);
     bool more = cycles_ < end && !finished_;
@@ -907,7 +912,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
     Tm::Tp* const tps = tm.tps.data();
     const uint32_t first_thread = tm.id * n;
     auto& counters = tm.counters;
-    bool my_turn = !host_threads_;
+    bool my_turn = !windows_in_parallel_;
     // Forced inline (GCC keeps a lambda called from two sites out of line): out of line, its
     // captures are reloaded through memory at every use.
     const auto fetch_part = [&](const RotatedPart& part) __attribute__((always_inline)) {

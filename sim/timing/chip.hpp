@@ -197,6 +197,8 @@ private:
     std::vector<TmClock> clocks_;
     uint64_t lookahead_ = 1;                     // cycles per window (at least 1)
     std::unique_ptr<HostThreads> host_threads_;  // none: every TM on the calling thread
+    // The TMs are running on the host threads: a step that is not private waits for its turn.
+    bool windows_in_parallel_ = false;
     std::vector<std::unique_ptr<Tm>> tms_;
     std::vector<Cache> l2s_;
     Dram dram_;
