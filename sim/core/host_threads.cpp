@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <memory>
-#include <thread>
 
 #include <oneapi/tbb/global_control.h>
 
@@ -15,7 +14,7 @@ std::unique_ptr<tbb::global_control> tbb_limit;
 }  // namespace
 
 uint32_t host_threads() {
-    return chosen != 0 ? chosen : std::max(1u, std::thread::hardware_concurrency());
+    return chosen != 0 ? chosen : 1;
 }
 
 void set_host_threads(uint32_t threads) {

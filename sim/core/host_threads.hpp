@@ -6,7 +6,9 @@
 
 namespace tpsim::core {
 
-/// The host threads set for this process; the host's cores until set.
+/// The host threads set for this process; 1 until set. The simulation is not faster on more
+/// threads yet (docs/performance.md, "Host threads": 0.81x on 2 cores for the default 4-TM
+/// chip), so it stays on one unless asked; oneTBB code (the BVH build) uses every core.
 uint32_t host_threads();
 /// Sets them (at least 1); also limits oneTBB's parallelism for the whole process.
 void set_host_threads(uint32_t threads);
