@@ -1000,4 +1000,128 @@ std::string sample_check_page(const Json& doc, const std::string& chart_js) {
     return page.finish("tpsim sample-check: " + scene, chart_js);
 }
 
+std::string sweep_page(const Json& doc, const std::string& chart_js) {
+    Page page;
+    const auto text = [](const Json& value) {
+        return value.is_string() ? value.get<std::string>() : value.dump();
+    };
+    const std::vector<std::string> axes = doc["axes"].get<std::vector<std::string>>();
+    const Json& rows = doc["rows"];
+    const Json& columns = doc["columns"];
+    std::string fixed;
+    for (const auto& [name, value] : doc["fixed"].items())
+        fixed += (fixed.empty() ? "" : " &middot; ") + escape(name + " = " + text(value));
+    size_t ok = 0;
+    for (const Json& row : rows)
+        ok += row["status"] == "ok";
+    page.body << fmt::format("<h1>tpsim sweep: {}</h1>\n<p class=\"sub\">{} jobs, {} finished "
+                             "&middot; axes: {}</p>\n",
+                             escape(doc.value("title", "")), rows.size(), ok,
+                             escape(fmt::format("{}", fmt::join(axes, ", "))));
+    if (!fixed.empty())
+        page.body << "<p class=\"sub\">the same in every job: " << fixed << "</p>\n";
+
+    // A metric against the x axis: one chart per scene (when the scene is an axis), one
+    // dataset per combination of the other axes.
+    const std::string x = doc["charts"].value("x", "");
+    const auto axis_index = [&](const std::string& name) {
+        return size_t(std::find(axes.begin(), axes.end(), name) - axes.begin());
+    };
+    const size_t x_axis = axis_index(x), scene_axis = axis_index("scene");
+    const bool per_scene = scene_axis < axes.size() && scene_axis != x_axis;
+    std::vector<std::string> panels;
+    for (const Json& row : rows) {
+        const std::string panel = per_scene ? text(row["values"][scene_axis]) : "";
+        if (std::find(panels.begin(), panels.end(), panel) == panels.end()) panels.push_back(panel);
+    }
+    bool numeric_x = true;
+    double x_min = INFINITY, x_max = -INFINITY;
+    std::vector<std::string> x_labels;
+    for (const Json& row : rows) {
+        if (x_axis >= axes.size()) break;
+        const Json& value = row["values"][x_axis];
+        numeric_x = numeric_x && value.is_number();
+        if (value.is_number()) {
+            x_min = std::min(x_min, value.get<double>());
+            x_max = std::max(x_max, value.get<double>());
+        }
+        if (std::find(x_labels.begin(), x_labels.end(), text(value)) == x_labels.end())
+            x_labels.push_back(text(value));
+    }
+    if (x_axis < axes.size()) page.body << "<h2>Charts</h2>\n<div class=\"charts\">\n";
+    for (const Json& metric_json : doc["charts"]["metrics"]) {
+        if (x_axis >= axes.size()) break;
+        const std::string metric = metric_json.get<std::string>();
+        size_t column = columns.size();
+        for (size_t c = 0; c < columns.size(); ++c)
+            if (columns[c]["name"] == metric) column = c;
+        for (const std::string& panel : panels) {
+            Chart chart{
+                .type = numeric_x ? "scatter" : "bar",
+                .title = metric + (panel.empty() ? "" : " — " + panel),
+                .unit = metric,
+                .x_title = x + (numeric_x && x_min > 0 && x_max >= 4 * x_min ? " (log scale)" : ""),
+                .x_log = numeric_x && x_min > 0 && x_max >= 4 * x_min};
+            if (!numeric_x) chart.labels = x_labels;
+            std::vector<std::string> series;
+            std::vector<Json> data;
+            for (const Json& row : rows) {
+                if (per_scene && text(row["values"][scene_axis]) != panel) continue;
+                std::string label;
+                for (size_t a = 0; a < axes.size(); ++a)
+                    if (a != x_axis && !(per_scene && a == scene_axis))
+                        label +=
+                            (label.empty() ? "" : ", ") + axes[a] + "=" + text(row["values"][a]);
+                if (label.empty()) label = metric;
+                const Json& y =
+                    column < columns.size() ? row["stats"][column] : row["host_seconds"];
+                auto found = std::find(series.begin(), series.end(), label);
+                if (found == series.end()) {
+                    series.push_back(label);
+                    data.push_back(numeric_x ? Json::array()
+                                             : Json(std::vector<Json>(x_labels.size())));
+                    found = series.end() - 1;
+                }
+                Json& points = data[size_t(found - series.begin())];
+                const Json& x_value = row["values"][x_axis];
+                if (numeric_x) {
+                    if (y.is_number()) points.push_back({{"x", x_value}, {"y", y}});
+                } else {
+                    points[size_t(std::find(x_labels.begin(), x_labels.end(), text(x_value)) -
+                                  x_labels.begin())] = y;
+                }
+            }
+            for (size_t s = 0; s < series.size(); ++s)
+                chart.add(series[s], data[s], true);
+            page.chart(chart);
+        }
+    }
+    if (x_axis < axes.size()) page.body << "</div>\n";
+
+    page.body << "<h2>Every job</h2>\n<table><tr><th>id</th>";
+    for (const std::string& axis : axes)
+        page.body << "<th>" << escape(axis) << "</th>";
+    page.body << "<th>status</th>";
+    for (const Json& c : columns)
+        page.body << "<th class=\"num\" title=\"" << escape(c.value("stat", "")) << "\">"
+                  << escape(c.value("name", "")) << "</th>";
+    page.body << "<th class=\"num\">host s</th></tr>\n";
+    for (const Json& row : rows) {
+        page.body << "<tr><td class=\"code\">" << escape(row.value("id", "")) << "</td>";
+        for (const Json& value : row["values"])
+            page.body << "<td>" << escape(text(value)) << "</td>";
+        page.body << "<td>" << escape(row.value("status", "")) << "</td>";
+        for (const Json& value : row["stats"])
+            page.body << "<td class=\"num\">"
+                      << (value.is_number() ? readable(value.get<double>()) : "-") << "</td>";
+        const Json& host = row["host_seconds"];
+        page.body << "<td class=\"num\">"
+                  << (host.is_number() ? fmt::format("{:.2f}", host.get<double>()) : "-")
+                  << "</td></tr>\n";
+    }
+    page.body << "</table>\n<p class=\"note\">host s: the host's wall time for the scene load, "
+                 "BVH build and run (not a result: it depends on the machine and its load).</p>\n";
+    return page.finish("tpsim sweep: " + doc.value("title", ""), chart_js);
+}
+
 }  // namespace tpsim::analysis
