@@ -180,7 +180,7 @@ int run_slurm(const SweepCommandOptions& o) {
                    dir.string());
         return 0;
     }
-    std::vector<std::string> args = {"sbatch", "--parsable"};
+    std::vector<std::string> args = {"sbatch"};
     if (o.wait) args.push_back("--wait");
     args.push_back(script.string());
     std::vector<char*> argv;

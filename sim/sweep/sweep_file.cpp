@@ -250,19 +250,8 @@ private:
                 fail(v.line,
                      fmt::format("{} must be {}, got {}", name,
                                  field.is_bool ? "true or false" : "an integer", v.value.dump()));
-            if (chip_keys) {
-                chip_keys->emplace_back(name, v);
-            } else {
-                timing::ChipConfig chip;
-                try {
-                    timing::apply_override(chip, fmt::format("{}={}", name, v.value.dump()));
-                } catch (const Error& e) {
-                    // "override 'k=v': message": the message alone, at the value's line
-                    const std::string what = e.what();
-                    const size_t colon = what.find("': ");
-                    fail(v.line, colon == std::string::npos ? what : what.substr(colon + 3));
-                }
-            }
+            // Ranges and cross-field rules are checked with the job's whole configuration.
+            if (chip_keys) chip_keys->emplace_back(name, v);
         }
     }
 
@@ -377,20 +366,30 @@ private:
             if (s.name != "config") apply(job.run, s.name, {s.value, line_of(s.name)}, &chip_keys);
         if (job.run.kernel.empty()) job.run.kernel = resolve_kernel_("tracer");
         if (chip_keys.empty()) return;
-        // All keys at once, then validated together: l1.line_bytes and l2.line_bytes may
-        // only change together.
+        // All keys at once over the base, then validated together (l1.line_bytes and
+        // l2.line_bytes may only change together). Each key is written on its line of the
+        // sweep file, so that an error about one key names the line it comes from.
+        std::sort(chip_keys.begin(), chip_keys.end(),
+                  [](const auto& a, const auto& b) { return a.second.line < b.second.line; });
         std::string toml;
-        for (const auto& [name, v] : chip_keys)
+        int64_t line = 1;
+        for (const auto& [name, v] : chip_keys) {
+            for (; line < v.line; ++line)
+                toml += '\n';
             toml += fmt::format("{} = {}\n", name, v.value.dump());
+            ++line;
+        }
+        const std::string source = file_.string();
         try {
-            job.run.chip = timing::parse_config(toml, "", job.run.chip);
+            job.run.chip = timing::parse_config(toml, source, job.run.chip);
         } catch (const Error& e) {
-            std::string what = e.what();
-            if (what.starts_with(": ")) what = what.substr(2);
-            fail(line_of(chip_keys.back().first),
-                 fmt::format("the job {} has a chip configuration tpsim refuses: {}; leave the "
-                             "combination out (zip) or change the values",
-                             sweep.describe(job), what));
+            const std::string what = e.what();
+            if (what.starts_with(source + ": "))  // a rule between fields, not one key's value
+                fail(chip_keys.back().second.line,
+                     fmt::format("the job {} has a chip configuration tpsim refuses: {}; leave "
+                                 "the combination out (zip) or change the values",
+                                 sweep.describe(job), what.substr(source.size() + 2)));
+            throw;
         }
     }
 
