@@ -128,13 +128,13 @@ size_t collect_and_write(const sweep::Sweep& s, const std::filesystem::path& dir
 int report_failures(const sweep::Sweep& s, const std::filesystem::path& dir) {
     const std::vector<sweep::Failure> failed = sweep::failures(s, dir);
     if (failed.empty()) return 0;
-    fmt::print("failed   {} of {} jobs:\n", failed.size(), s.jobs.size());
+    fmt::print("unfinished {} of {} jobs:\n", failed.size(), s.jobs.size());
     for (const sweep::Failure& f : failed)
-        fmt::print("         {}  {}: {}\n", f.job->id, s.describe(*f.job), f.reason);
+        fmt::print("           {}  {}: {}\n", f.job->id, s.describe(*f.job), f.reason);
     std::fflush(stdout);
     fmt::print(stderr,
-               "tpsim: {} of {} jobs failed (listed above); fix the cause and run the same "
-               "command again: finished jobs are skipped\n",
+               "tpsim: {} of {} jobs did not finish (listed above); fix the cause and run the "
+               "same command again: finished jobs are skipped\n",
                failed.size(), s.jobs.size());
     return 2;
 }

@@ -107,8 +107,8 @@ std::vector<Failure> failures(const Sweep& sweep, const std::filesystem::path& d
     std::vector<Failure> list;
     for (const Job& job : sweep.jobs) {
         if (finished(dir, job)) continue;
-        std::string reason = fmt::format("no statistics file and no error recorded: the job did "
-                                         "not run, or was killed (see {})",
+        std::string reason = fmt::format("no error recorded: not run yet, still running, or "
+                                         "killed (see {})",
                                          log_dir(dir).string());
         if (std::ifstream in(error_path(dir, job.id)); in && std::getline(in, reason)) {
         }

@@ -254,7 +254,7 @@ l1.size_bytes = [4096, 8192]
     const auto failed = failures(sweep, results);
     REQUIRE(failed.size() == 2);
     CHECK(failed[0].reason == "scene.toml:3: bad camera");
-    CHECK(failed[1].reason.starts_with("no statistics file and no error recorded"));
+    CHECK(failed[1].reason.starts_with("no error recorded: not run yet, still running, or killed"));
 
     const Table table = collect(sweep, results, default_columns());
     REQUIRE(table.rows.size() == 4);
