@@ -63,8 +63,8 @@ std::string readable(double value) {
 
 /// One chart for the JSON blob; report_page.js draws it with Chart.js.
 struct Chart {
-    /// "bar" (labels + values), "line" ({x, y} points over cycles) or "scatter" ({x, y, label}
-    /// points, optionally joined: a dataset's "line")
+    /// "bar" (labels + values), "line" ({x, y} points over cycles, or values over labels: a
+    /// sweep's axis) or "scatter" ({x, y, label} points, optionally joined: a dataset's "line")
     std::string type = "bar";
     std::string title = "";
     std::string unit = "";  ///< the value axis title
@@ -1021,30 +1021,34 @@ std::string sweep_page(const Json& doc, const std::string& chart_js) {
     if (!fixed.empty())
         page.body << "<p class=\"sub\">the same in every job: " << fixed << "</p>\n";
 
-    // A metric against the x axis: one chart per scene (when the scene is an axis), one
-    // dataset per combination of the other axes.
-    const std::string x = doc["charts"].value("x", "");
+    // A metric against the x axis, one dataset per value of the `by` axis; one chart per
+    // combination of the remaining axes. Without `by`: one chart per scene (when the scene is
+    // an axis), one dataset per combination of the other axes.
     const auto axis_index = [&](const std::string& name) {
         return size_t(std::find(axes.begin(), axes.end(), name) - axes.begin());
     };
-    const size_t x_axis = axis_index(x), scene_axis = axis_index("scene");
-    const bool per_scene = scene_axis < axes.size() && scene_axis != x_axis;
-    std::vector<std::string> panels;
-    for (const Json& row : rows) {
-        const std::string panel = per_scene ? text(row["values"][scene_axis]) : "";
-        if (std::find(panels.begin(), panels.end(), panel) == panels.end()) panels.push_back(panel);
-    }
+    const size_t x_axis = axis_index(doc["charts"].value("x", ""));
+    const size_t by_axis = axis_index(doc["charts"].value("by", ""));
+    const size_t scene_axis = axis_index("scene");
+    const auto in_panel = [&](size_t a) {
+        if (a == x_axis || a == by_axis) return false;
+        return by_axis < axes.size() || a == scene_axis;
+    };
+    const auto join = [&](const Json& row, auto&& take) {
+        std::string label;
+        for (size_t a = 0; a < axes.size(); ++a)
+            if (take(a))
+                label += (label.empty() ? "" : ", ") + axes[a] + "=" + text(row["values"][a]);
+        return label;
+    };
+    std::vector<std::string> panels, x_labels;
     bool numeric_x = true;
-    double x_min = INFINITY, x_max = -INFINITY;
-    std::vector<std::string> x_labels;
     for (const Json& row : rows) {
         if (x_axis >= axes.size()) break;
+        const std::string panel = join(row, in_panel);
+        if (std::find(panels.begin(), panels.end(), panel) == panels.end()) panels.push_back(panel);
         const Json& value = row["values"][x_axis];
         numeric_x = numeric_x && value.is_number();
-        if (value.is_number()) {
-            x_min = std::min(x_min, value.get<double>());
-            x_max = std::max(x_max, value.get<double>());
-        }
         if (std::find(x_labels.begin(), x_labels.end(), text(value)) == x_labels.end())
             x_labels.push_back(text(value));
     }
@@ -1056,43 +1060,35 @@ std::string sweep_page(const Json& doc, const std::string& chart_js) {
         for (size_t c = 0; c < columns.size(); ++c)
             if (columns[c]["name"] == metric) column = c;
         for (const std::string& panel : panels) {
-            Chart chart{
-                .type = numeric_x ? "scatter" : "bar",
-                .title = metric + (panel.empty() ? "" : " — " + panel),
-                .unit = metric,
-                .x_title = x + (numeric_x && x_min > 0 && x_max >= 4 * x_min ? " (log scale)" : ""),
-                .x_log = numeric_x && x_min > 0 && x_max >= 4 * x_min};
-            if (!numeric_x) chart.labels = x_labels;
+            // The x values as categories, evenly spaced (sizes are usually powers of two):
+            // lines over a numeric axis, grouped bars over a text one.
+            Chart chart{.type = numeric_x ? "line" : "bar",
+                        .title = metric + (panel.empty() ? "" : " (" + panel + ")"),
+                        .unit = metric,
+                        .x_title = axes[x_axis]};
+            chart.labels = x_labels;
             std::vector<std::string> series;
             std::vector<Json> data;
             for (const Json& row : rows) {
-                if (per_scene && text(row["values"][scene_axis]) != panel) continue;
-                std::string label;
-                for (size_t a = 0; a < axes.size(); ++a)
-                    if (a != x_axis && !(per_scene && a == scene_axis))
-                        label +=
-                            (label.empty() ? "" : ", ") + axes[a] + "=" + text(row["values"][a]);
+                if (join(row, in_panel) != panel) continue;
+                std::string label =
+                    join(row, [&](size_t a) { return a != x_axis && !in_panel(a); });
                 if (label.empty()) label = metric;
-                const Json& y =
-                    column < columns.size() ? row["stats"][column] : row["host_seconds"];
                 auto found = std::find(series.begin(), series.end(), label);
                 if (found == series.end()) {
                     series.push_back(label);
-                    data.push_back(numeric_x ? Json::array()
-                                             : Json(std::vector<Json>(x_labels.size())));
+                    data.push_back(Json(std::vector<Json>(x_labels.size())));
                     found = series.end() - 1;
                 }
-                Json& points = data[size_t(found - series.begin())];
-                const Json& x_value = row["values"][x_axis];
-                if (numeric_x) {
-                    if (y.is_number()) points.push_back({{"x", x_value}, {"y", y}});
-                } else {
-                    points[size_t(std::find(x_labels.begin(), x_labels.end(), text(x_value)) -
-                                  x_labels.begin())] = y;
-                }
+                const size_t x = size_t(
+                    std::find(x_labels.begin(), x_labels.end(), text(row["values"][x_axis])) -
+                    x_labels.begin());
+                data[size_t(found - series.begin())][x] =
+                    column < columns.size() ? row["stats"][column] : row["host_seconds"];
             }
-            for (size_t s = 0; s < series.size(); ++s)
-                chart.add(series[s], data[s], true);
+            for (size_t k = 0; k < series.size(); ++k)
+                chart.add(series[k], data[k]);
+            chart.tall = series.size() > 4;  // room for the legend
             page.chart(chart);
         }
     }

@@ -28,6 +28,7 @@ struct CollectOptions {
     std::vector<std::string> columns;  // NAME=KEY
     std::vector<std::string> metrics;
     std::string x;
+    std::string by;
     bool no_host_time = false;
     std::string csv, markdown, html;
 };
@@ -109,6 +110,7 @@ size_t collect_and_write(const sweep::Sweep& s, const std::filesystem::path& dir
     sweep::ChartChoice charts = sweep::default_charts(table);
     if (!c.metrics.empty()) charts.metrics = c.metrics;
     if (!c.x.empty()) charts.x = c.x;
+    charts.by = c.by;
     const sweep::Json document =
         sweep::table_document(table, charts, std::filesystem::path(s.file).stem().string());
     const bool host = !c.no_host_time;
@@ -246,6 +248,10 @@ void add_collect_options(CLI::App* command, CollectOptions& c) {
     command->add_option("--x", c.x,
                         "The axis the charts' x axis follows [default: the first axis that is "
                         "not the scene]");
+    command->add_option("--by", c.by,
+                        "One line per value of this axis, one chart per combination of the "
+                        "others [default: one chart per scene, one line per combination of the "
+                        "other axes]");
     command->add_flag("--no-host-time", c.no_host_time,
                       "Leave the host time out of the CSV and Markdown tables, so that two "
                       "runs of a sweep compare byte for byte");

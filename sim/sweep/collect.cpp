@@ -136,7 +136,7 @@ std::string table_markdown(const Table& table, bool host_time) {
 }
 
 ChartChoice default_charts(const Table& table) {
-    ChartChoice choice{{"cycles", "dram_bytes_read"}, ""};
+    ChartChoice choice{{"cycles", "dram_bytes_read"}, "", ""};
     for (const std::string& axis : table.axes)
         if (axis != "scene") {
             choice.x = axis;
@@ -151,6 +151,11 @@ Json table_document(const Table& table, const ChartChoice& charts, const std::st
         std::find(table.axes.begin(), table.axes.end(), charts.x) == table.axes.end())
         throw Error(fmt::format("--x {}: the sweep has no such axis; its axes are {}", charts.x,
                                 fmt::join(table.axes, ", ")));
+    if (!charts.by.empty() &&
+        (charts.by == charts.x ||
+         std::find(table.axes.begin(), table.axes.end(), charts.by) == table.axes.end()))
+        throw Error(fmt::format("--by {}: give an axis other than --x {}; the sweep's axes are {}",
+                                charts.by, charts.x, fmt::join(table.axes, ", ")));
     for (const std::string& metric : charts.metrics)
         if (metric != "host_seconds" &&
             std::none_of(table.columns.begin(), table.columns.end(),
@@ -177,7 +182,7 @@ Json table_document(const Table& table, const ChartChoice& charts, const std::st
     doc["fixed"] = std::move(fixed);
     doc["columns"] = std::move(columns);
     doc["rows"] = std::move(rows);
-    doc["charts"] = {{"metrics", charts.metrics}, {"x", charts.x}};
+    doc["charts"] = {{"metrics", charts.metrics}, {"x", charts.x}, {"by", charts.by}};
     return doc;
 }
 

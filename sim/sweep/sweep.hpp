@@ -150,11 +150,13 @@ Table collect(const Sweep& sweep, const std::filesystem::path& dir,
 std::string table_csv(const Table& table, bool host_time);
 std::string table_markdown(const Table& table, bool host_time);
 
-/// What the page charts: `metrics` (column names) against axis `x`, one chart per scene when
-/// the scene is an axis, one line (or bar group) per combination of the other axes.
+/// What the page charts: `metrics` (column names) against axis `x`, one line (or bar group) per
+/// value of axis `by` and one chart per combination of the other axes; without `by`, one chart
+/// per scene (when the scene is an axis) and one line per combination of the other axes.
 struct ChartChoice {
     std::vector<std::string> metrics;
     std::string x;
+    std::string by;  ///< may be empty
 };
 /// The default: frame cycles and DRAM bytes read against the first axis that is not the scene.
 ChartChoice default_charts(const Table& table);

@@ -282,9 +282,13 @@ l1.size_bytes = [4096, 8192]
     const Json doc = table_document(table, default_charts(table), "t");
     CHECK(doc["charts"]["x"] == "bvh");
     CHECK(doc["rows"][2]["status"] == "failed");
-    CHECK_THROWS_WITH(table_document(table, {{"cycles"}, "l2.size_bytes"}, "t"),
+    CHECK_THROWS_WITH(table_document(table, {{"cycles"}, "l2.size_bytes", ""}, "t"),
                       Catch::Contains("--x l2.size_bytes: the sweep has no such axis"));
-    CHECK_THROWS_WITH(table_document(table, {{"energy"}, "bvh"}, "t"),
+    CHECK_THROWS_WITH(table_document(table, {{"cycles"}, "bvh", "bvh"}, "t"),
+                      Catch::Contains("--by bvh: give an axis other than --x bvh"));
+    CHECK(table_document(table, {{"cycles"}, "bvh", "l1.size_bytes"}, "t")["charts"]["by"] ==
+          "l1.size_bytes");
+    CHECK_THROWS_WITH(table_document(table, {{"energy"}, "bvh", ""}, "t"),
                       Catch::Contains("--metric energy: the table has no such column"));
 }
 
