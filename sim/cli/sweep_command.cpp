@@ -237,13 +237,13 @@ int run_one_job(const SweepCommandOptions& o) {
 void add_collect_options(CLI::App* command, CollectOptions& c) {
     command
         ->add_option("--column", c.columns,
-                     "Add a statistic to the table as NAME=KEY (e.g. "
+                     "Add a statistic to the table as NAME=KEY, or KEY named by itself (e.g. "
                      "operand_stalls=chip/stalls/operand; docs/statistics.md lists the keys)")
         ->allow_extra_args(false);
     command
         ->add_option("--metric", c.metrics,
-                     "Chart this table column against --x, one chart per scene [default: "
-                     "cycles and dram_bytes_read]")
+                     "Chart this table column against --x; repeat for more [default: cycles "
+                     "and dram_bytes_read]")
         ->allow_extra_args(false);
     command->add_option("--x", c.x,
                         "The axis the charts' x axis follows [default: the first axis that is "
@@ -287,8 +287,8 @@ Command add_sweep_command(CLI::App& app) {
     sweep_file(list);
 
     auto* run = command->add_subcommand(
-        "run", "Run the sweep's unfinished jobs on this machine through GNU parallel, list the "
-               "jobs that failed, and collect the table and page");
+        "run", "Run the sweep's unfinished jobs on this machine through GNU parallel, collect "
+               "the table and page, and list the jobs that did not finish");
     sweep_file(run);
     output_dir(run);
     run->add_option("-j,--jobs", o->workers, "Jobs run at once [default: the number of cores]")

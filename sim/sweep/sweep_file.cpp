@@ -119,14 +119,14 @@ private:
         return std::nullopt;
     }
 
-    static Value scalar(const toml::node& node, const std::string& name, int64_t line,
-                        const Reader& reader) {
+    Value scalar(const toml::node& node, const std::string& name) const {
+        const int64_t line = node.source().begin.line;
         if (const auto s = node.value_exact<std::string>()) return {*s, line};
         if (const auto i = node.value_exact<int64_t>()) return {*i, line};
         if (const auto b = node.value_exact<bool>()) return {*b, line};
-        reader.fail(line, fmt::format("{} must be a string, an integer or true/false, or an "
-                                      "array of them (an axis)",
-                                      name));
+        fail(line, fmt::format("{} must be a string, an integer or true/false, or an array of "
+                               "them (an axis)",
+                               name));
     }
 
     void collect_entries(const toml::table& table, const std::string& prefix) {
@@ -147,10 +147,8 @@ private:
                 entry.axis = true;
                 if (array->empty())
                     fail(line, fmt::format("the axis {} has no values: give at least one", name));
-                for (const toml::node& element : *array) {
-                    const int64_t element_line = element.source().begin.line;
-                    entry.values.push_back(scalar(element, name, element_line, *this));
-                }
+                for (const toml::node& element : *array)
+                    entry.values.push_back(scalar(element, name));
                 for (size_t i = 0; i < entry.values.size(); ++i)
                     for (size_t j = 0; j < i; ++j)
                         if (entry.values[i].value == entry.values[j].value)
@@ -158,7 +156,7 @@ private:
                                  fmt::format("the axis {} has the value {} twice", name,
                                              entry.values[i].value.dump()));
             } else {
-                entry.values.push_back(scalar(node, name, line, *this));
+                entry.values.push_back(scalar(node, name));
             }
             entries_.push_back(std::move(entry));
         }
