@@ -58,6 +58,20 @@ std::string value_text(const Json& value) {
     return value.is_string() ? value.get<std::string>() : value.dump();
 }
 
+/// The chip configuration as the TOML lines of the fields that differ from the defaults: the
+/// plan stays small (every job reads it), and parse_config reads it back.
+std::string changed_fields(const timing::ChipConfig& chip) {
+    const std::vector<timing::ConfigField> defaults = timing::config_fields({});
+    const std::vector<timing::ConfigField> fields = timing::config_fields(chip);
+    std::string lines;
+    for (size_t f = 0; f < fields.size(); ++f)
+        if (fields[f].value != defaults[f].value)
+            lines += fmt::format("{} = {}\n", fields[f].key,
+                                 fields[f].is_bool ? (fields[f].value ? "true" : "false")
+                                                   : std::to_string(fields[f].value));
+    return lines;
+}
+
 class Reader {
 public:
     Reader(std::filesystem::path file, const KernelResolver& resolve_kernel)
@@ -457,7 +471,7 @@ void write_plan(const Sweep& sweep, const std::filesystem::path& dir) {
                           {"spp", r.spp},
                           {"seed", r.seed},
                           {"timing", r.timing},
-                          {"chip", timing::to_toml(r.chip)}}}});
+                          {"chip", changed_fields(r.chip)}}}});
     }
     doc["axes"] = std::move(axes);
     doc["fixed"] = std::move(fixed);
