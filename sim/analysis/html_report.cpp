@@ -63,8 +63,8 @@ std::string readable(double value) {
 
 /// One chart for the JSON blob; report_page.js draws it with Chart.js.
 struct Chart {
-    /// "bar" (labels + values), "line" ({x, y} points over cycles) or "scatter" ({x, y, label}
-    /// points, optionally joined: a dataset's "line")
+    /// "bar" (labels + values), "line" ({x, y} points over cycles, or values over labels: a
+    /// sweep's axis) or "scatter" ({x, y, label} points, optionally joined: a dataset's "line")
     std::string type = "bar";
     std::string title = "";
     std::string unit = "";  ///< the value axis title
@@ -998,6 +998,126 @@ std::string sample_check_page(const Json& doc, const std::string& chart_js) {
         page.body << "</table>\n";
     }
     return page.finish("tpsim sample-check: " + scene, chart_js);
+}
+
+std::string sweep_page(const Json& doc, const std::string& chart_js) {
+    Page page;
+    const auto text = [](const Json& value) {
+        return value.is_string() ? value.get<std::string>() : value.dump();
+    };
+    const std::vector<std::string> axes = doc["axes"].get<std::vector<std::string>>();
+    const Json& rows = doc["rows"];
+    const Json& columns = doc["columns"];
+    std::string fixed;
+    for (const auto& [name, value] : doc["fixed"].items())
+        fixed += (fixed.empty() ? "" : " &middot; ") + escape(name + " = " + text(value));
+    size_t ok = 0;
+    for (const Json& row : rows)
+        ok += row["status"] == "ok";
+    page.body << fmt::format("<h1>tpsim sweep: {}</h1>\n<p class=\"sub\">{} jobs, {} finished "
+                             "&middot; axes: {}</p>\n",
+                             escape(doc.value("title", "")), rows.size(), ok,
+                             escape(fmt::format("{}", fmt::join(axes, ", "))));
+    if (!fixed.empty())
+        page.body << "<p class=\"sub\">the same in every job: " << fixed << "</p>\n";
+
+    // A metric against the x axis, one dataset per value of the `by` axis; one chart per
+    // combination of the remaining axes. Without `by`: one chart per scene (when the scene is
+    // an axis), one dataset per combination of the other axes.
+    const auto axis_index = [&](const std::string& name) {
+        return size_t(std::find(axes.begin(), axes.end(), name) - axes.begin());
+    };
+    const size_t x_axis = axis_index(doc["charts"].value("x", ""));
+    const size_t by_axis = axis_index(doc["charts"].value("by", ""));
+    const size_t scene_axis = axis_index("scene");
+    const auto in_panel = [&](size_t a) {
+        if (a == x_axis || a == by_axis) return false;
+        return by_axis < axes.size() || a == scene_axis;
+    };
+    const auto join = [&](const Json& row, auto&& take) {
+        std::string label;
+        for (size_t a = 0; a < axes.size(); ++a)
+            if (take(a))
+                label += (label.empty() ? "" : ", ") + axes[a] + "=" + text(row["values"][a]);
+        return label;
+    };
+    std::vector<std::string> panels, x_labels;
+    bool numeric_x = true;
+    for (const Json& row : rows) {
+        if (x_axis >= axes.size()) break;
+        const std::string panel = join(row, in_panel);
+        if (std::find(panels.begin(), panels.end(), panel) == panels.end()) panels.push_back(panel);
+        const Json& value = row["values"][x_axis];
+        numeric_x = numeric_x && value.is_number();
+        if (std::find(x_labels.begin(), x_labels.end(), text(value)) == x_labels.end())
+            x_labels.push_back(text(value));
+    }
+    if (x_axis < axes.size()) page.body << "<h2>Charts</h2>\n<div class=\"charts\">\n";
+    for (const Json& metric_json : doc["charts"]["metrics"]) {
+        if (x_axis >= axes.size()) break;
+        const std::string metric = metric_json.get<std::string>();
+        size_t column = columns.size();
+        for (size_t c = 0; c < columns.size(); ++c)
+            if (columns[c]["name"] == metric) column = c;
+        for (const std::string& panel : panels) {
+            // The x values as categories, evenly spaced (sizes are usually powers of two):
+            // lines over a numeric axis, grouped bars over a text one.
+            Chart chart{.type = numeric_x ? "line" : "bar",
+                        .title = metric + (panel.empty() ? "" : " (" + panel + ")"),
+                        .unit = metric,
+                        .x_title = axes[x_axis]};
+            chart.labels = x_labels;
+            std::vector<std::string> series;
+            std::vector<Json> data;
+            for (const Json& row : rows) {
+                if (join(row, in_panel) != panel) continue;
+                std::string label =
+                    join(row, [&](size_t a) { return a != x_axis && !in_panel(a); });
+                if (label.empty()) label = metric;
+                auto found = std::find(series.begin(), series.end(), label);
+                if (found == series.end()) {
+                    series.push_back(label);
+                    data.push_back(Json(std::vector<Json>(x_labels.size())));
+                    found = series.end() - 1;
+                }
+                const size_t x = size_t(
+                    std::find(x_labels.begin(), x_labels.end(), text(row["values"][x_axis])) -
+                    x_labels.begin());
+                data[size_t(found - series.begin())][x] =
+                    column < columns.size() ? row["stats"][column] : row["host_seconds"];
+            }
+            for (size_t k = 0; k < series.size(); ++k)
+                chart.add(series[k], data[k]);
+            chart.tall = series.size() > 4;  // room for the legend
+            page.chart(chart);
+        }
+    }
+    if (x_axis < axes.size()) page.body << "</div>\n";
+
+    page.body << "<h2>Every job</h2>\n<table><tr><th>id</th>";
+    for (const std::string& axis : axes)
+        page.body << "<th>" << escape(axis) << "</th>";
+    page.body << "<th>status</th>";
+    for (const Json& c : columns)
+        page.body << "<th class=\"num\" title=\"" << escape(c.value("stat", "")) << "\">"
+                  << escape(c.value("name", "")) << "</th>";
+    page.body << "<th class=\"num\">host s</th></tr>\n";
+    for (const Json& row : rows) {
+        page.body << "<tr><td class=\"code\">" << escape(row.value("id", "")) << "</td>";
+        for (const Json& value : row["values"])
+            page.body << "<td>" << escape(text(value)) << "</td>";
+        page.body << "<td>" << escape(row.value("status", "")) << "</td>";
+        for (const Json& value : row["stats"])
+            page.body << "<td class=\"num\">"
+                      << (value.is_number() ? readable(value.get<double>()) : "-") << "</td>";
+        const Json& host = row["host_seconds"];
+        page.body << "<td class=\"num\">"
+                  << (host.is_number() ? fmt::format("{:.2f}", host.get<double>()) : "-")
+                  << "</td></tr>\n";
+    }
+    page.body << "</table>\n<p class=\"note\">host s: the host's wall time for the scene load, "
+                 "BVH build and run (not a result: it depends on the machine and its load).</p>\n";
+    return page.finish("tpsim sweep: " + doc.value("title", ""), chart_js);
 }
 
 }  // namespace tpsim::analysis

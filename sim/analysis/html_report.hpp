@@ -30,4 +30,8 @@ std::string converge_page(const Json& document, const std::filesystem::path& bas
 /// statistic's error against speedup with its interval, coverage over the seeds, and the tables.
 std::string sample_check_page(const Json& document, const std::string& chart_js);
 
+/// The page of `tpsim sweep collect` (its table document, sweep/sweep.hpp table_document): a
+/// chart of each chosen metric against the chosen axis, one per scene, and every job's row.
+std::string sweep_page(const Json& document, const std::string& chart_js);
+
 }  // namespace tpsim::analysis

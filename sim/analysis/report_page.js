@@ -90,11 +90,15 @@
             grid: { color: function (c) { return c.tick && c.tick.value === 0 && scatter
                                                  ? '#5b6170' : 'rgba(0, 0, 0, 0.1)'; } }
         }, barRange(spec));
-        // Timelines span exactly cycle 0 to the last sample.
-        const lastCycle = spec.type === 'line'
+        // Timelines ({x, y} points) span exactly cycle 0 to the last sample; a line over
+        // labels (a sweep's axis values) has them as categories.
+        const timeline = spec.type === 'line' && spec.labels.length === 0;
+        const lastCycle = timeline
             ? Math.max.apply(null, spec.datasets[0].data.map(function (p) { return p.x; })) : 0;
-        const categoryAxis = spec.type === 'line'
+        const categoryAxis = timeline
             ? { type: 'linear', min: 0, max: lastCycle, title: { display: true, text: 'cycle' } }
+            : spec.type === 'line'
+            ? { title: { display: true, text: spec.xTitle } }
             : scatter
             ? { type: spec.xLog ? 'logarithmic' : 'linear', grace: '3%',
                 title: { display: true, text: spec.xTitle } }
@@ -121,7 +125,8 @@
                 const colour = palette[k % palette.length];
                 return { label: d.label, data: d.data, backgroundColor: colour,
                          borderColor: colour, borderWidth: spec.type === 'bar' ? 0 : 2,
-                         pointRadius: spec.type === 'scatter' ? 4 : 0,
+                         pointRadius: spec.type === 'scatter' ||
+                                      (spec.type === 'line' && spec.labels.length) ? 4 : 0,
                          showLine: spec.type !== 'scatter' || !!d.line };
             });
             new Chart(canvas, { type: spec.type, data: { labels: spec.labels, datasets: datasets },

@@ -79,5 +79,6 @@ Command add_check_command(CLI::App& app);
 Command add_new_kernel_command(CLI::App& app);
 Command add_converge_command(CLI::App& app);
 Command add_sample_check_command(CLI::App& app);
+Command add_sweep_command(CLI::App& app);
 
 }  // namespace tpsim::cli

@@ -21,7 +21,8 @@ int main(int argc, char** argv) {
         tpsim::cli::add_render_command(app),   tpsim::cli::add_exec_command(app),
         tpsim::cli::add_compare_command(app),  tpsim::cli::add_report_command(app),
         tpsim::cli::add_check_command(app),    tpsim::cli::add_new_kernel_command(app),
-        tpsim::cli::add_converge_command(app), tpsim::cli::add_sample_check_command(app)};
+        tpsim::cli::add_converge_command(app), tpsim::cli::add_sample_check_command(app),
+        tpsim::cli::add_sweep_command(app)};
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -38,7 +39,7 @@ int main(int argc, char** argv) {
         fmt::print(
             stderr,
             "tpsim: give a subcommand: render, exec, compare, report, converge, sample-check, "
-            "new-kernel or check (tpsim --help)\n");
+            "sweep, new-kernel or check (tpsim --help)\n");
         return 2;
     }
     int status = 0;

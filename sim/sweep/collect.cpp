@@ -1,0 +1,189 @@
+// Collecting a sweep: every job's axis values and key statistics in one table (CSV, Markdown,
+// and the JSON document its HTML page is drawn from).
+#include <algorithm>
+
+#include <fmt/format.h>
+
+#include "sim/analysis/compare.hpp"
+#include "sim/analysis/stats_file.hpp"
+#include "sim/core/error.hpp"
+#include "sim/stats/thousands.hpp"
+#include "sim/sweep/sweep.hpp"
+
+namespace tpsim::sweep {
+namespace {
+
+std::string value_text(const Json& value) {
+    return value.is_string() ? value.get<std::string>() : value.dump();
+}
+
+/// A CSV field: quoted when it holds a comma, quote or line break.
+std::string csv_field(const std::string& text) {
+    if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
+    std::string quoted = "\"";
+    for (char ch : text)
+        quoted += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+    return quoted + "\"";
+}
+
+/// Exact: the shortest text that reads back as the same double.
+std::string exact(const std::optional<double>& value) {
+    return value ? fmt::format("{}", *value) : std::string();
+}
+
+/// For a person: whole numbers with thousands separators, others to 4 significant digits.
+std::string readable(const std::optional<double>& value) {
+    if (!value) return "-";
+    const std::string text = analysis::format_number(*value);
+    if (text.find_first_not_of("-0123456789") != std::string::npos) return text;
+    return stats::with_thousands(text);
+}
+
+}  // namespace
+
+std::vector<Column> default_columns() {
+    return {{"cycles", "chip/cycles"},
+            {"instructions", "instructions/total"},
+            {"rays", "rays/total"},
+            {"l1_hit_rate", "chip/l1/hit_rate"},
+            {"l2_hit_rate", "chip/l2/hit_rate"},
+            {"dram_bytes_read", "dram/bytes_read"},
+            {"dram_bytes_written", "dram/bytes_written"}};
+}
+
+Table collect(const Sweep& sweep, const std::filesystem::path& dir,
+              const std::vector<Column>& columns) {
+    Table table;
+    for (const Axis& axis : sweep.axes)
+        table.axes.push_back(axis.name);
+    table.fixed = sweep.fixed;
+    table.columns = columns;
+    for (const Job& job : sweep.jobs) {
+        Table::Row row{job.id, "missing", job.values, {}, std::nullopt};
+        row.stats.resize(columns.size());
+        if (finished(dir, job)) {
+            const analysis::StatsFile run = analysis::load_stats_file(stats_path(dir, job.id));
+            row.status = "ok";
+            for (size_t c = 0; c < columns.size(); ++c)
+                row.stats[c] = run.stat(columns[c].stat);
+            double host = 0;
+            bool any = false;
+            for (const char* key : {"host/load_seconds", "host/bvh_seconds", "host/run_seconds"})
+                if (const auto seconds = run.stat(key)) {
+                    host += *seconds;
+                    any = true;
+                }
+            if (any) row.host_seconds = host;
+        } else if (std::error_code ec; std::filesystem::exists(error_path(dir, job.id), ec)) {
+            row.status = "failed";
+        }
+        table.rows.push_back(std::move(row));
+    }
+    return table;
+}
+
+std::string table_csv(const Table& table, bool host_time) {
+    std::string out = "id";
+    for (const std::string& axis : table.axes)
+        out += fmt::format(",{}", csv_field(axis));
+    out += ",status";
+    for (const Column& column : table.columns)
+        out += fmt::format(",{}", csv_field(column.name));
+    out += host_time ? ",host_seconds\n" : "\n";
+    for (const Table::Row& row : table.rows) {
+        out += row.id;
+        for (const Json& value : row.values)
+            out += fmt::format(",{}", csv_field(value_text(value)));
+        out += "," + row.status;
+        for (const auto& stat : row.stats)
+            out += fmt::format(",{}", exact(stat));
+        if (host_time) out += fmt::format(",{}", exact(row.host_seconds));
+        out += "\n";
+    }
+    return out;
+}
+
+std::string table_markdown(const Table& table, bool host_time) {
+    std::string head = "| id |", rule = "|---|";
+    for (const std::string& axis : table.axes) {
+        head += " " + axis + " |";
+        rule += "---|";
+    }
+    head += " status |";
+    rule += "---|";
+    for (const Column& column : table.columns) {
+        head += " " + column.name + " |";
+        rule += "---:|";
+    }
+    if (host_time) {
+        head += " host s |";
+        rule += "---:|";
+    }
+    std::string out = head + "\n" + rule + "\n";
+    for (const Table::Row& row : table.rows) {
+        out += "| " + row.id + " |";
+        for (const Json& value : row.values)
+            out += fmt::format(" {} |", value_text(value));
+        out += " " + row.status + " |";
+        for (const auto& stat : row.stats)
+            out += fmt::format(" {} |", readable(stat));
+        if (host_time)
+            out += row.host_seconds ? fmt::format(" {:.2f} |", *row.host_seconds)
+                                    : std::string(" - |");
+        out += "\n";
+    }
+    return out;
+}
+
+ChartChoice default_charts(const Table& table) {
+    ChartChoice choice{{"cycles", "dram_bytes_read"}, "", ""};
+    for (const std::string& axis : table.axes)
+        if (axis != "scene") {
+            choice.x = axis;
+            break;
+        }
+    if (choice.x.empty() && !table.axes.empty()) choice.x = table.axes[0];
+    return choice;
+}
+
+Json table_document(const Table& table, const ChartChoice& charts, const std::string& title) {
+    if (!charts.x.empty() &&
+        std::find(table.axes.begin(), table.axes.end(), charts.x) == table.axes.end())
+        throw Error(fmt::format("--x {}: the sweep has no such axis; its axes are {}", charts.x,
+                                fmt::join(table.axes, ", ")));
+    if (!charts.by.empty() &&
+        (charts.by == charts.x ||
+         std::find(table.axes.begin(), table.axes.end(), charts.by) == table.axes.end()))
+        throw Error(fmt::format("--by {}: give an axis other than --x {}; the sweep's axes are {}",
+                                charts.by, charts.x, fmt::join(table.axes, ", ")));
+    for (const std::string& metric : charts.metrics)
+        if (metric != "host_seconds" &&
+            std::none_of(table.columns.begin(), table.columns.end(),
+                         [&](const Column& c) { return c.name == metric; }))
+            throw Error(fmt::format("--metric {}: the table has no such column; give one of its "
+                                    "columns or add a statistic with --column NAME=KEY",
+                                    metric));
+    Json doc = {{"format", "tpsim-sweep-table"}, {"title", title}, {"axes", table.axes}};
+    Json fixed = Json::object(), columns = Json::array(), rows = Json::array();
+    for (const Setting& s : table.fixed)
+        fixed[s.name] = s.value;
+    for (const Column& c : table.columns)
+        columns.push_back({{"name", c.name}, {"stat", c.stat}});
+    for (const Table::Row& row : table.rows) {
+        Json stats = Json::array();
+        for (const auto& s : row.stats)
+            stats.push_back(s ? Json(*s) : Json());
+        rows.push_back({{"id", row.id},
+                        {"status", row.status},
+                        {"values", row.values},
+                        {"stats", std::move(stats)},
+                        {"host_seconds", row.host_seconds ? Json(*row.host_seconds) : Json()}});
+    }
+    doc["fixed"] = std::move(fixed);
+    doc["columns"] = std::move(columns);
+    doc["rows"] = std::move(rows);
+    doc["charts"] = {{"metrics", charts.metrics}, {"x", charts.x}, {"by", charts.by}};
+    return doc;
+}
+
+}  // namespace tpsim::sweep
