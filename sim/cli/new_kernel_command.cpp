@@ -1,12 +1,9 @@
 // `tpsim new-kernel DIR`: starts a kernel in a folder of its own (outside the tpsim tree): writes
 // a CMake project that finds this tpsim build as a package, a kernel (a working one from
 // kernel/template, or an assignment's starter) and a README, then configures and builds it.
-#include <spawn.h>
-#include <sys/wait.h>
 
 #include <algorithm>
 #include <cctype>
-#include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <memory>
@@ -19,8 +16,7 @@
 #include "sim/cli/commands.hpp"
 #include "sim/core/error.hpp"
 #include "sim/core/input_file.hpp"
-
-extern char** environ;
+#include "sim/core/program.hpp"
 
 namespace tpsim::cli {
 namespace {
@@ -89,17 +85,10 @@ std::string substitute(std::string text, const std::string& key, const std::stri
 /// Runs a command with the terminal's output (the student sees the compiler's messages);
 /// true when it exits 0.
 bool run(const std::vector<std::string>& args) {
-    std::vector<char*> argv;
-    for (const std::string& arg : args)
-        argv.push_back(const_cast<char*>(arg.c_str()));
-    argv.push_back(nullptr);
-    pid_t child = 0;
-    if (const int error = posix_spawnp(&child, argv[0], nullptr, nullptr, argv.data(), environ))
-        throw Error(fmt::format("cannot run {}: {}", args[0], std::strerror(error)));
-    int status = 0;
-    while (waitpid(child, &status, 0) < 0)
-        if (errno != EINTR) throw Error(fmt::format("lost {}: {}", args[0], std::strerror(errno)));
-    return WIFEXITED(status) && WEXITSTATUS(status) == 0;
+    const ProgramExit ran = run_program(args);
+    if (ran.start_error != 0)
+        throw Error(fmt::format("cannot run {}: {}", args[0], std::strerror(ran.start_error)));
+    return ran.succeeded();
 }
 
 int run_new_kernel(const NewKernelOptions& o) {

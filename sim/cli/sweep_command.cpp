@@ -11,15 +11,12 @@
 #include <vector>
 
 #include <fmt/format.h>
-#include <spawn.h>
-#include <sys/wait.h>
 
 #include "sim/analysis/html_report.hpp"
 #include "sim/cli/commands.hpp"
 #include "sim/core/error.hpp"
+#include "sim/core/program.hpp"
 #include "sim/sweep/sweep.hpp"
-
-extern char** environ;
 
 namespace tpsim::cli {
 namespace {
@@ -185,21 +182,13 @@ int run_slurm(const SweepCommandOptions& o) {
     std::vector<std::string> args = {"sbatch"};
     if (o.wait) args.push_back("--wait");
     args.push_back(script.string());
-    std::vector<char*> argv;
-    for (std::string& a : args)
-        argv.push_back(a.data());
-    argv.push_back(nullptr);
-    std::fflush(stdout);
-    pid_t pid = 0;
-    if (const int error = posix_spawnp(&pid, "sbatch", nullptr, nullptr, argv.data(), environ))
+    const ProgramExit ran = run_program(args);
+    if (ran.start_error != 0)
         throw Error(fmt::format("cannot run sbatch ({}): run this on a Slurm cluster's login "
                                 "node, or submit {} there yourself",
-                                std::strerror(error), script.string()));
-    int status = 0;
-    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-    }
+                                std::strerror(ran.start_error), script.string()));
     // With --wait, sbatch's status says whether every task succeeded; failures() says which.
-    if (!o.wait && !(WIFEXITED(status) && WEXITSTATUS(status) == 0))
+    if (!o.wait && !ran.succeeded())
         throw Error(fmt::format("sbatch refused {} (its message is above)", script.string()));
     if (!o.wait) {
         fmt::print("next     when the array is done: tpsim sweep collect {}\n", dir.string());

@@ -1,22 +1,17 @@
 // Running a sweep's jobs: one job in this process, all of them through GNU parallel, or a
 // Slurm job array's batch script.
-#include <cerrno>
-#include <cstdio>
 #include <cstring>
 #include <fstream>
 
 #include <fmt/format.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include "sim/core/error.hpp"
+#include "sim/core/program.hpp"
 #include "sim/render/image_file.hpp"
 #include "sim/render/render.hpp"
 #include "sim/render/report.hpp"
 #include "sim/sweep/sweep.hpp"
-
-extern char** environ;
 
 namespace tpsim::sweep {
 namespace {
@@ -135,22 +130,14 @@ void run_parallel(const Sweep& sweep, const std::filesystem::path& dir, unsigned
     for (const std::string& word : {std::string("-q"), tpsim_exe.string(), std::string("sweep"),
                                     std::string("job"), dir.string(), std::string("{}")})
         args.push_back(word);
-    std::vector<char*> argv;
-    for (std::string& a : args)
-        argv.push_back(a.data());
-    argv.push_back(nullptr);
-    std::fflush(stdout);
-    pid_t pid = 0;
-    if (const int error = posix_spawnp(&pid, "parallel", nullptr, nullptr, argv.data(), environ))
+    const ProgramExit ran = run_program(args);
+    if (ran.start_error != 0)
         throw Error(fmt::format("cannot start GNU parallel ({}): install the Debian package "
                                 "'parallel' (scripts/setup does)",
-                                std::strerror(error)));
-    int status = 0;
-    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-    }
+                                std::strerror(ran.start_error)));
     // parallel's status counts failed jobs, which failures() lists; only a parallel that
     // could not run at all (255) is an error here.
-    if (WIFEXITED(status) && WEXITSTATUS(status) == 255)
+    if (ran.exit_code() == 255)
         throw Error(fmt::format("GNU parallel failed (exit status 255); see its messages above "
                                 "and {}",
                                 (log_dir(dir) / "parallel.log").string()));
