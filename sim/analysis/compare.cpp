@@ -369,14 +369,6 @@ void write_markdown(const Comparison& c, std::ostream& out) {
     }
 }
 
-std::string csv_field(const std::string& text) {
-    if (text.find_first_of(",\"\n") == std::string::npos) return text;
-    std::string quoted = "\"";
-    for (char ch : text)
-        quoted += ch == '"' ? std::string("\"\"") : std::string(1, ch);
-    return quoted + "\"";
-}
-
 /// Exact figures for machines: integers in full, reals in the shortest round-trip form.
 std::string csv_number(std::optional<double> value) {
     if (!value || !std::isfinite(*value)) return "";
@@ -488,6 +480,14 @@ std::optional<double> Row::ratio(size_t run) const {
 bool Row::differs_notably(size_t run) const {
     const auto r = ratio(run);
     return r && (*r < 0.95 || *r > 1.05);
+}
+
+std::string csv_field(const std::string& text) {
+    if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
+    std::string quoted = "\"";
+    for (char ch : text)
+        quoted += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+    return quoted + "\"";
 }
 
 std::string format_number(double value) {

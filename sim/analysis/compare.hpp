@@ -61,4 +61,8 @@ void write_comparison(const Comparison& comparison, Format format, std::ostream&
 /// A number as the tables show it: whole numbers exactly, others to 4 significant digits.
 std::string format_number(double value);
 
+/// A CSV field (RFC 4180): quoted, with quotes doubled, when it holds a comma, a quote or a
+/// line break.
+std::string csv_field(const std::string& text);
+
 }  // namespace tpsim::analysis

@@ -17,15 +17,6 @@ std::string value_text(const Json& value) {
     return value.is_string() ? value.get<std::string>() : value.dump();
 }
 
-/// A CSV field: quoted when it holds a comma, quote or line break.
-std::string csv_field(const std::string& text) {
-    if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
-    std::string quoted = "\"";
-    for (char ch : text)
-        quoted += ch == '"' ? std::string("\"\"") : std::string(1, ch);
-    return quoted + "\"";
-}
-
 /// Exact: the shortest text that reads back as the same double.
 std::string exact(const std::optional<double>& value) {
     return value ? fmt::format("{}", *value) : std::string();
@@ -85,15 +76,15 @@ Table collect(const Sweep& sweep, const std::filesystem::path& dir,
 std::string table_csv(const Table& table, bool host_time) {
     std::string out = "id";
     for (const std::string& axis : table.axes)
-        out += fmt::format(",{}", csv_field(axis));
+        out += fmt::format(",{}", analysis::csv_field(axis));
     out += ",status";
     for (const Column& column : table.columns)
-        out += fmt::format(",{}", csv_field(column.name));
+        out += fmt::format(",{}", analysis::csv_field(column.name));
     out += host_time ? ",host_seconds\n" : "\n";
     for (const Table::Row& row : table.rows) {
         out += row.id;
         for (const Json& value : row.values)
-            out += fmt::format(",{}", csv_field(value_text(value)));
+            out += fmt::format(",{}", analysis::csv_field(value_text(value)));
         out += "," + row.status;
         for (const auto& stat : row.stats)
             out += fmt::format(",{}", exact(stat));
