@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <barrier>
 #include <bit>
 #include <exception>
 #include <thread>
@@ -59,6 +58,8 @@ Machine::Machine(Program program, const MachineConfig& config)
             break;
         case isa::FuClass::Atomic:
         case isa::FuClass::System:
+        case isa::FuClass::Sync:
+        case isa::FuClass::Print:  // another thread's fault reports the output printed before it
             privacy_.push_back(Privacy::Never);
             break;
         default:
@@ -247,7 +248,7 @@ void Machine::run_lanes(uint32_t lanes) {
     bool more_rounds = running_threads_ != 0;
     // Between rounds, one look at running_threads_ decides for every lane.
     std::atomic<uint64_t> first_failure{OrderedTurns::kDone};
-    std::barrier round_end(lanes, [&]() noexcept {
+    SpinBarrier round_end(lanes, [&]() noexcept {
         more_rounds = running_threads_ != 0 && first_failure.load() == OrderedTurns::kDone;
     });
     // Whether each thread waits (at the barrier, for a semaphore), as its own lane last saw it.

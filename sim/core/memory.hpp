@@ -48,6 +48,14 @@ public:
     bool in_read_only_global(uint32_t addr) const {
         return addr - global_.base < read_only_global_;
     }
+    /// True if no store can change `addr`: the read-only part of global memory or a read-only
+    /// segment of the program (its code and constants).
+    bool in_read_only(uint32_t addr) const {
+        if (in_read_only_global(addr)) return true;
+        for (const Region& r : program_regions_)
+            if (!r.writable && addr - r.base < r.size) return true;
+        return false;
+    }
     uint32_t local_store_bytes() const { return local_.size; }
 
     template <class T> T load(uint32_t addr, uint8_t* local) const {

@@ -9,7 +9,8 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
-#include <thread>
+
+#include "sim/core/spin_wait.hpp"
 
 namespace tpsim::core {
 
@@ -21,7 +22,8 @@ public:
     /// Thrown by a lane whose next action comes after another lane's failure: it stops there.
     struct Abandoned {};
 
-    explicit OrderedTurns(uint32_t lanes) : lanes_(lanes), at_(new Position[lanes]) {}
+    explicit OrderedTurns(uint32_t lanes)
+        : lanes_(lanes), spins_(spins_for(lanes)), at_(new Position[lanes]) {}
 
     uint32_t lanes() const { return lanes_; }
     /// Lane `lane` has done everything before `position` (non-decreasing per lane).
@@ -32,22 +34,17 @@ public:
     void wait_turn(uint32_t lane, uint64_t position) const {
         for (uint32_t other = 0; other < lanes_; ++other) {
             if (other == lane) continue;
-            // Spin (the other lane is usually a few steps behind), then yield: on a busy host
-            // the lane waited for may be descheduled.
-            for (uint32_t spins = 0; at_[other].value.load(std::memory_order_acquire) <= position;
-                 ++spins)
-                if (spins >= kSpins) std::this_thread::yield();
+            // The other lane is usually a few steps behind (spin_until).
+            spin_until([&] { return at_[other].value.load(std::memory_order_acquire) > position; },
+                       spins_);
         }
     }
 
 private:
-    // Spins briefly before yielding: on an idle host the yield returns at once, on a busy one
-    // the thread waited for may need this core.
-    static constexpr uint32_t kSpins = 64;
     struct alignas(64) Position {  // own cache line: lanes write theirs at every step
         std::atomic<uint64_t> value{0};
     };
-    uint32_t lanes_;
+    uint32_t lanes_, spins_;
     std::unique_ptr<Position[]> at_;
 };
 

@@ -303,11 +303,11 @@ inline bool Machine::is_private(const isa::Hart& h, uint32_t index, uint32_t wor
     const Privacy privacy = privacy_[index];
     if (privacy == Privacy::Always || privacy == Privacy::Never) return privacy == Privacy::Always;
     // The local store, its overflow guard and the unmapped space above are private: an access
-    // there either touches the thread's own store or faults. Loads from read-only memory see
-    // the same value whenever they run.
+    // there either touches the thread's own store or faults. Loads from read-only memory (the
+    // scene, the kernel's constants) see the same value whenever they run.
     const isa::Decoded& d = decoded_[index];
     const uint32_t addr = h.reg[d.rs1] + uint32_t(d.imm);
-    return in_local_store(addr) || (privacy == Privacy::Load && memory_.in_read_only_global(addr));
+    return in_local_store(addr) || (privacy == Privacy::Load && memory_.in_read_only(addr));
 }
 
 inline bool Machine::next_is_private(uint32_t id) const {

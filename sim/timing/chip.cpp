@@ -347,7 +347,7 @@ struct Chip::HostThreads {
         HostThreads* host;
         void operator()() noexcept { host->between(); }
     };
-    std::barrier<Between> window_done{turns.lanes(), Between{this}};
+    core::SpinBarrier<Between> window_done{turns.lanes(), Between{this}};
     bool stop = false;
     const std::function<void(uint32_t)>* job = nullptr;
     std::vector<std::thread> threads;

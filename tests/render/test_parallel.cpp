@@ -15,6 +15,7 @@
 #include "sim/core/fault.hpp"
 #include "sim/core/host_threads.hpp"
 #include "sim/core/ordered_turns.hpp"
+#include "sim/core/spin_wait.hpp"
 #include "sim/render/render.hpp"
 #include "sim/render/report.hpp"
 #include "sim/render/timing_run.hpp"
@@ -124,6 +125,45 @@ TEST_CASE("ordered turns: actions at increasing positions run in position order 
             t.join();
         CHECK(log.size() > kPositions / 5);
         CHECK(std::is_sorted(log.begin(), log.end()));
+    }
+}
+
+TEST_CASE("spin barrier: each completion sees every thread's phase, and only then do they go on",
+          "[parallel]") {
+    // Every thread writes its own plain slot before arriving; the completion checks that all
+    // slots hold the phase and records it; after the barrier each thread checks the record. A
+    // thread that drops out halfway leaves the others going with one fewer.
+    for (uint32_t count : {2u, 3u, 8u}) {
+        INFO(count << " threads");
+        constexpr uint32_t kPhases = 20'000, kDropAt = kPhases / 2;
+        std::vector<uint32_t> slots(count, 0);
+        uint32_t completed = 0, bad = 0, arrivals = count;
+        const auto completion = [&]() noexcept {
+            for (uint32_t t = 0; t < arrivals; ++t)
+                bad += slots[t] != completed + 1;
+            ++completed;
+            if (completed == kDropAt) arrivals = count - 1;  // the last thread dropped in this one
+        };
+        core::SpinBarrier barrier(count, completion);
+        std::atomic<uint32_t> late{0};
+        std::vector<std::thread> threads;
+        for (uint32_t t = 0; t < count; ++t)
+            threads.emplace_back([&, t] {
+                for (uint32_t phase = 1; phase <= kPhases; ++phase) {
+                    slots[t] = phase;
+                    if (t == count - 1 && phase == kDropAt) {
+                        barrier.arrive_and_drop();
+                        return;
+                    }
+                    barrier.arrive_and_wait();
+                    late += completed < phase;
+                }
+            });
+        for (std::thread& t : threads)
+            t.join();
+        CHECK(completed == kPhases);
+        CHECK(bad == 0);
+        CHECK(late == 0);
     }
 }
 

@@ -1,0 +1,83 @@
+// Waiting between host threads that meet every few microseconds (the parallel simulation's
+// windows and turns). Sleeping in the kernel costs more than such a wait: a futex wake of a
+// thread whose core went idle takes tens of microseconds on a virtual machine, longer than a
+// window's work. So a waiter spins, with the CPU's pause hint, for about as long as a window
+// lasts, and then yields its core on every try (on a busy host the thread it waits for may need
+// that core).
+#pragma once
+#include <atomic>
+#include <cstdint>
+#include <thread>
+#include <utility>
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#endif
+
+namespace tpsim::core {
+
+/// Tells the CPU this is a spin-wait loop (fewer wasted cycles, the sibling hyper-thread runs).
+inline void cpu_relax() {
+#if defined(__x86_64__) || defined(__i386__)
+    _mm_pause();
+#elif defined(__aarch64__)
+    asm volatile("yield");
+#endif
+}
+
+/// How long `lanes` threads that wait for each other should spin before yielding: about a
+/// window's work (2^14 pauses, 50-500 µs depending on the CPU) when each can have a core of its
+/// own; barely, when there are more of them than cores (the one waited for needs a core).
+inline uint32_t spins_for(uint32_t lanes) {
+    return lanes <= std::thread::hardware_concurrency() ? 1u << 14 : 64;
+}
+
+/// Returns once ready() is true: spins `spins` times, then yields between tries.
+template <class Ready> void spin_until(Ready&& ready, uint32_t spins) {
+    for (uint32_t tries = 0; !ready(); ++tries)
+        if (tries < spins)
+            cpu_relax();
+        else
+            std::this_thread::yield();
+}
+
+/// A reusable barrier for `count` threads, like std::barrier, that waits by spinning
+/// (spin_until) instead of sleeping. The last thread to arrive runs `completion` before any is
+/// let go; everything each thread did before arriving happens before the completion, and the
+/// completion before everything each does after.
+template <class Completion> class SpinBarrier {
+public:
+    SpinBarrier(uint32_t count, Completion completion)
+        : spins_(spins_for(count)), completion_(std::move(completion)), count_(count) {}
+
+    void arrive_and_wait() { arrive(false); }
+    /// Arrives without waiting, and leaves: later phases wait for one thread fewer.
+    void arrive_and_drop() { arrive(true); }
+
+private:
+    void arrive(bool drop) {
+        // Neither can change before this thread arrives, so reading them first is exact.
+        const uint32_t phase = phase_.load(std::memory_order_acquire);
+        const uint32_t count = count_.load(std::memory_order_relaxed);
+        if (drop) dropping_.fetch_add(1, std::memory_order_relaxed);
+        if (arrived_.fetch_add(1, std::memory_order_acq_rel) + 1 == count) {
+            completion_();
+            count_.store(count - dropping_.exchange(0, std::memory_order_relaxed),
+                         std::memory_order_relaxed);
+            arrived_.store(0, std::memory_order_relaxed);  // both published by the release below
+            phase_.store(phase + 1, std::memory_order_release);
+        } else if (!drop) {
+            spin_until([&] { return phase_.load(std::memory_order_acquire) != phase; }, spins_);
+        }
+    }
+
+    const uint32_t spins_;
+    Completion completion_;
+    // Own cache lines: every arrival writes the first, every waiter reads the second.
+    alignas(64) std::atomic<uint32_t> arrived_{0};
+    std::atomic<uint32_t> dropping_{0};
+    alignas(64) std::atomic<uint32_t> phase_{0};
+    std::atomic<uint32_t> count_;
+};
+
+}  // namespace tpsim::core
