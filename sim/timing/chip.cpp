@@ -66,7 +66,8 @@ constexpr std::string_view kReservedRegions[] = {"other", "local_store", "instru
 
 }  // namespace
 
-struct Chip::Tm {
+// On its own cache lines: TMs ticked on different host threads never share one.
+struct alignas(64) Chip::Tm {
     // Per-TP flags the cycle loop tests for many TPs at once are bit sets over the TPs (bit
     // i of word i / 64); the rest of a TP's state is in Tp.
     using TpBits = std::vector<uint64_t>;

@@ -53,14 +53,17 @@ inline std::unique_ptr<core::Machine> make_machine(const core::Program& program,
 class MachineSource final : public InstructionSource {
 public:
     explicit MachineSource(core::Machine& machine)
-        : machine_(machine), ahead_(machine.thread_count()), next_pc_(machine.thread_count()) {
+        : machine_(machine), ahead_(machine.thread_count()),
+          next_pcs_((machine.thread_count() + kPcsPerLine - 1) / kPcsPerLine) {
         for (uint32_t t = 0; t < machine.thread_count(); ++t)
-            next_pc_[t] = machine.next_pc(t);
+            next_pc_of(t) = machine.next_pc(t);
     }
 
     core::Machine& machine() const { return machine_; }
 
-    uint32_t next_pc(uint32_t thread) const override { return next_pc_[thread]; }
+    uint32_t next_pc(uint32_t thread) const override {
+        return next_pcs_[thread / kPcsPerLine].pc[thread % kPcsPerLine];
+    }
 
     /// Records run ahead are private (executed already); so is the next instruction if the
     /// machine says so. A fault waiting for its fetch is not: it must be raised in turn.
@@ -76,7 +79,7 @@ public:
             run_ahead(thread, a);
         }
         out = a.records[a.next++];
-        next_pc_[thread] = a.next < a.size ? a.records[a.next].pc : machine_.next_pc(thread);
+        next_pc_of(thread) = a.next < a.size ? a.records[a.next].pc : machine_.next_pc(thread);
     }
 
     /// Functional warming (Chip::warm): thread `thread` executes up to `budget` instructions,
@@ -100,7 +103,7 @@ public:
             stopped = machine_.run_observed(thread, budget - executed, more, last, observer);
             executed += more;
         }
-        next_pc_[thread] = a.next < a.size ? a.records[a.next].pc : machine_.next_pc(thread);
+        next_pc_of(thread) = a.next < a.size ? a.records[a.next].pc : machine_.next_pc(thread);
         return stopped;
     }
 
@@ -121,7 +124,9 @@ public:
 
 private:
     static constexpr uint32_t kAhead = 128;  // records buffered per thread
-    struct Ahead {
+    // Each thread's on its own cache lines (as are the machine's threads): the threads of TMs
+    // simulated on different host threads must not share a line that both write.
+    struct alignas(64) Ahead {
         std::array<StepInfo, kAhead> records;
         uint32_t next = 0, size = 0;
         // A fault of an instruction run ahead, raised when the chip fetches that instruction.
@@ -141,7 +146,16 @@ private:
 
     core::Machine& machine_;
     std::vector<Ahead> ahead_;
-    std::vector<uint32_t> next_pc_;  // per thread, dense: the chip asks every fetch cycle
+    // Per thread, dense (the chip asks every fetch cycle), in whole cache lines: TMs of a
+    // multiple of 16 threads (32 by default) never share one.
+    static constexpr uint32_t kPcsPerLine = 16;
+    struct alignas(64) PcLine {
+        std::array<uint32_t, kPcsPerLine> pc{};
+    };
+    std::vector<PcLine> next_pcs_;
+    uint32_t& next_pc_of(uint32_t thread) {
+        return next_pcs_[thread / kPcsPerLine].pc[thread % kPcsPerLine];
+    }
 };
 
 }  // namespace tpsim::timing
