@@ -321,9 +321,11 @@ Command add_render_command(CLI::App& app) {
         ->add_option_function<uint32_t>(
             "--threads", [](uint32_t threads) { core::set_host_threads(threads); },
             "Host threads to simulate on (the chip's TMs, the functional machine's threads); "
-            "the image and every statistic are the same for any number")
+            "the image and every statistic are the same for any number. Unset: the "
+            "cycle-level chip runs on all cores or on one, whichever is faster as it goes; "
+            "the functional machine on one")
         ->check(kPositiveCount)
-        ->default_str(std::to_string(core::host_threads()));
+        ->default_str(fmt::format("up to {}", core::host_threads()));
     command
         ->add_option("--max-instructions", o->max_instructions,
                      "Instructions a thread may run before it is stopped as a runaway")

@@ -15,6 +15,7 @@
 #include "sim/analysis/html_report.hpp"
 #include "sim/cli/commands.hpp"
 #include "sim/core/error.hpp"
+#include "sim/core/host_threads.hpp"
 #include "sim/core/program.hpp"
 #include "sim/sweep/sweep.hpp"
 
@@ -212,6 +213,9 @@ int run_one_job(const SweepCommandOptions& o) {
     if (!job)
         throw Error(fmt::format("the sweep in '{}' has no job {}; tpsim sweep list names them",
                                 dir.string(), o.id));
+    // A sweep's parallelism is its jobs (one per core under GNU parallel, one per Slurm task):
+    // each runs on one host thread rather than wait for threads of its own without a core.
+    core::set_host_threads(1);
     const auto started = std::chrono::steady_clock::now();
     try {
         sweep::run_job(s, *job, dir);

@@ -42,13 +42,20 @@ template <class Ready> void spin_until(Ready&& ready, uint32_t spins) {
             std::this_thread::yield();
 }
 
-/// A reusable barrier for `count` threads, like std::barrier, that waits by spinning
-/// (spin_until) instead of sleeping. The last thread to arrive runs `completion` before any is
-/// let go; everything each thread did before arriving happens before the completion, and the
-/// completion before everything each does after.
-template <class Completion> class SpinBarrier {
+/// No completion step.
+struct NoCompletion {
+    void operator()() noexcept {}
+};
+
+/// A reusable barrier for `count` threads, like std::barrier, that spins (spins_for) before it
+/// sleeps: threads meeting every few microseconds then meet without a system call, and a
+/// thread left waiting long (another has no core, or the run is between chunks) stops using
+/// its core. The last thread to arrive runs `completion` before any is let go; everything each
+/// thread did before arriving happens before the completion, and the completion before
+/// everything each does after.
+template <class Completion = NoCompletion> class SpinBarrier {
 public:
-    SpinBarrier(uint32_t count, Completion completion)
+    explicit SpinBarrier(uint32_t count, Completion completion = {})
         : spins_(spins_for(count)), completion_(std::move(completion)), count_(count) {}
 
     void arrive_and_wait() { arrive(false); }
@@ -67,8 +74,13 @@ private:
                          std::memory_order_relaxed);
             arrived_.store(0, std::memory_order_relaxed);  // both published by the release below
             phase_.store(phase + 1, std::memory_order_release);
+            phase_.notify_all();  // no system call unless a thread sleeps
         } else if (!drop) {
-            spin_until([&] { return phase_.load(std::memory_order_acquire) != phase; }, spins_);
+            for (uint32_t tries = 0; phase_.load(std::memory_order_acquire) == phase; ++tries)
+                if (tries < spins_)
+                    cpu_relax();
+                else
+                    phase_.wait(phase, std::memory_order_acquire);
         }
     }
 

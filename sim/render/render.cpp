@@ -31,7 +31,9 @@ KernelRun run_functional(const core::Program& program, image::MemoryImage& image
                          uint64_t max_item_instructions) {
     const auto machine = timing::make_machine(program, image.words, image.read_only_bytes(), chip,
                                               max_instructions, max_item_instructions);
-    machine->run(core::host_threads());
+    // Unless asked for more, one host thread: the functional machine is not faster on two
+    // (docs/performance.md, "Host threads").
+    machine->run(core::host_threads_set() ? core::host_threads() : 1);
     std::memcpy(image.words.data(), machine->memory().global().data(), image.bytes());
     return {InstructionCounts::of(machine->counters()), machine->output()};
 }

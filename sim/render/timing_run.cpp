@@ -1,7 +1,9 @@
 #include "sim/render/timing_run.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cstring>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -22,7 +24,13 @@ std::shared_ptr<TimingRun> run_timing(const core::Program& program, image::Memor
     layout.profile = options.profile;
     run->chip = std::make_unique<timing::Chip>(chip, *run->source, layout);
     timing::Chip& model = *run->chip;
-    model.use_host_threads(core::host_threads());
+    // --threads unset: sampled runs stay on one host thread (their units of a few thousand
+    // cycles are too short to share), full runs choose as they go.
+    std::optional<core::HostThreadChoice> choice;
+    if (core::host_threads_set())
+        model.use_host_threads(core::host_threads());
+    else if (!options.sampling)
+        choice.emplace(core::host_threads());
     stats::Registry chip_stats;
     model.register_stats(chip_stats);
     const auto report = [&] {
@@ -55,7 +63,18 @@ std::shared_ptr<TimingRun> run_timing(const core::Program& program, image::Memor
     // past the end before they stop, hence the cap.
     constexpr uint64_t kInterval = timing::Chip::kProgressInterval;
     uint64_t next_report = kInterval;
-    while (!model.run_until(std::min(next_report, timeline.next_sample()))) {
+    const auto run_chunk = [&](uint64_t until) {
+        if (!choice) return model.run_until(until);
+        model.use_host_threads(choice->next());
+        const uint64_t before = machine.counters().instructions;
+        const auto start = std::chrono::steady_clock::now();
+        const bool finished = model.run_until(until);
+        choice->ran(
+            machine.counters().instructions - before,
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        return finished;
+    };
+    while (!run_chunk(std::min(next_report, timeline.next_sample()))) {
         if (model.cycles() == timeline.next_sample()) timeline.sample(model.cycles());
         if (model.cycles() == next_report) {
             next_report += kInterval;

@@ -11,7 +11,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <barrier>
 #include <bit>
 #include <functional>
 #include <stdexcept>
@@ -342,7 +341,8 @@ struct Chip::HostThreads {
     };
     std::vector<Failure> failures = std::vector<Failure>(turns.lanes());
     std::atomic<uint64_t> first_failure{core::OrderedTurns::kDone};
-    std::barrier<> start, done;
+    // Between runs the lanes sleep (after a short spin: runs follow each other closely).
+    core::SpinBarrier<> start, done;
     std::function<void()> between;  // must not throw
     struct Between {
         HostThreads* host;
@@ -356,6 +356,8 @@ struct Chip::HostThreads {
 
 void Chip::use_host_threads(uint32_t threads) {
     const uint32_t lanes = std::clamp<uint32_t>(threads, 1, config_.chip.num_tms);
+    if (lanes == lanes_) return;
+    lanes_ = lanes;
     if (layout_.profile) collect();  // the lanes' counts so far go on in lane 0
     host_threads_.reset();
     if (lanes > 1) host_threads_ = std::make_unique<HostThreads>(lanes);

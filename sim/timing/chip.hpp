@@ -197,6 +197,7 @@ private:
     std::vector<TmClock> clocks_;
     uint64_t lookahead_ = 1;                     // cycles per window (at least 1)
     std::unique_ptr<HostThreads> host_threads_;  // none: every TM on the calling thread
+    uint32_t lanes_ = 0;                         // host threads the TMs run on; 0: not yet set
     // The TMs are running on the host threads: a step that is not private waits for its turn.
     bool windows_in_parallel_ = false;
     std::vector<std::unique_ptr<Tm>> tms_;

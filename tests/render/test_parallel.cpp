@@ -1,6 +1,7 @@
 // Parallel simulation: the cycle-level chip and the functional machine on 1, 2, 3 and 8 host
 // threads give the same statistics, images, profiles, per-pixel costs, kernel output and
 // faults, on chips of one TM, several, an odd count, and fewer TMs than host threads.
+#include <algorithm>
 #include <atomic>
 #include <cstring>
 #include <random>
@@ -165,6 +166,42 @@ TEST_CASE("spin barrier: each completion sees every thread's phase, and only the
         CHECK(bad == 0);
         CHECK(late == 0);
     }
+}
+
+TEST_CASE("host thread choice: keeps the faster count, tries the other again ever less often",
+          "[parallel]") {
+    // Chunks of 10 ms: a phase of kTrySeconds is 5 chunks. Returns the counts chunk by chunk
+    // when `most` threads do `speedup` times the work per second of one.
+    const auto counts = [](double speedup, uint32_t chunks) {
+        core::HostThreadChoice choice(4);
+        std::string seen;
+        for (uint32_t c = 0; c < chunks; ++c) {
+            const uint32_t threads = choice.next();
+            seen += char('0' + threads);
+            choice.ran(threads == 1 ? 1000 : uint64_t(1000 * speedup), 0.01);
+        }
+        return seen;
+    };
+    // Faster: one phase on 1, then on 4, trying 1 again after 4 phases, then 8, ...
+    const std::string faster = counts(2.0, 100);
+    CHECK(faster.substr(0, 10) == "1111144444");
+    CHECK(faster.substr(10, 20) == std::string(20, '4'));
+    CHECK(faster.substr(30, 5) == "11111");
+    CHECK(faster.substr(35, 20) == std::string(20, '4'));
+    CHECK(faster.substr(55, 5) == "11111");
+    CHECK(faster.substr(60, 40) == std::string(40, '4'));
+    // Slower: back to 1 after each try, tried after 4, 8, 16 phases.
+    const std::string slower = counts(0.5, 200);
+    CHECK(slower.substr(0, 10) == "1111144444");
+    CHECK(slower.substr(10, 20) == std::string(20, '1'));
+    CHECK(slower.substr(30, 5) == "44444");
+    CHECK(slower.substr(35, 40) == std::string(40, '1'));
+    CHECK(slower.substr(75, 5) == "44444");
+    CHECK(std::count(slower.begin(), slower.end(), '4') == 20);
+    // One host thread: nothing to choose.
+    core::HostThreadChoice one(1);
+    one.ran(1000, 1.0);
+    CHECK(one.next() == 1);
 }
 
 TEST_CASE("parallel: the tracer on the cycle-level chip is the same on any host threads",
