@@ -79,13 +79,21 @@ std::vector<std::string> keys_like(const std::vector<StatsFile>& runs, std::stri
 
 Section summary_section(const std::vector<StatsFile>& runs) {
     Section s{"summary", {}};
-    const std::pair<const char*, Better> keys[] = {
-        {"chip/cycles", Better::lower},           {"chip/frame_seconds", Better::lower},
-        {"chip/rays_per_second", Better::higher}, {"instructions/total", Better::lower},
-        {"chip/issue_rate", Better::higher},      {"chip/l1/hit_rate", Better::higher},
-        {"chip/l2/hit_rate", Better::higher},     {"dram/bytes_read", Better::lower},
-        {"dram/bytes_written", Better::lower},    {"chip/dram/bandwidth_gbps", Better::neutral},
-        {"rays/total", Better::neutral}};
+    const std::pair<const char*, Better> keys[] = {{"chip/cycles", Better::lower},
+                                                   {"chip/frame_seconds", Better::lower},
+                                                   {"chip/rays_per_second", Better::higher},
+                                                   {"instructions/total", Better::lower},
+                                                   {"chip/issue_rate", Better::higher},
+                                                   {"chip/l1/hit_rate", Better::higher},
+                                                   {"chip/l2/hit_rate", Better::higher},
+                                                   {"dram/bytes_read", Better::lower},
+                                                   {"dram/bytes_written", Better::lower},
+                                                   {"chip/dram/bandwidth_gbps", Better::neutral},
+                                                   {"rays/total", Better::neutral},
+                                                   {"energy/total", Better::lower},
+                                                   {"energy/average_watts", Better::lower},
+                                                   {"energy/mrays_per_joule", Better::higher},
+                                                   {"area/total", Better::lower}};
     for (const auto& [key, better] : keys)
         s.rows.push_back(stat_row(runs, key, better));
     return s;
@@ -96,6 +104,23 @@ Section keyed_section(const std::vector<StatsFile>& runs, std::string title,
     Section s{std::move(title), {}};
     for (const std::string& key : keys_like(runs, prefix, suffix))
         s.rows.push_back(stat_row(runs, key, better));
+    return s;
+}
+
+/// Every statistic under `prefix` (any depth, file order) but the totals and rates the summary
+/// and per-ray sections show: the energy and area estimate's parts (docs/energy.md).
+Section parts_section(const std::vector<StatsFile>& runs, std::string title,
+                      std::string_view prefix) {
+    const std::set<std::string, std::less<>> shown_elsewhere = {
+        "energy/total",   "energy/average_watts", "energy/mrays_per_joule",
+        "energy/per_ray", "energy/per_pixel",     "area/total"};
+    std::vector<std::string> keys;
+    for (const StatsFile& run : runs)
+        for (const auto& [name, value] : run.stats)
+            if (name.starts_with(prefix) && !shown_elsewhere.contains(name)) add_unique(keys, name);
+    Section s{std::move(title), {}};
+    for (const std::string& key : keys)
+        s.rows.push_back(stat_row(runs, key, Better::lower));
     return s;
 }
 
@@ -153,6 +178,7 @@ Section per_ray_section(const std::vector<StatsFile>& runs) {
                                      if (!read || !written) return std::nullopt;
                                      return quotient(*read + *written, run.stat("rays/total"));
                                  }));
+    s.rows.push_back(stat_row(runs, "energy/per_ray", Better::lower));
     s.rows.push_back(stat_row(runs, "traversal/nodes_per_ray", Better::lower));
     s.rows.push_back(stat_row(runs, "traversal/triangles_per_ray", Better::lower));
     return s;
@@ -509,6 +535,8 @@ Comparison compare(const std::vector<StatsFile>& runs, const std::vector<std::st
         keyed_section(runs, "FU utilisation", "chip/fu/", "/utilisation", Better::neutral));
     c.sections.push_back(traffic_section(runs));
     c.sections.push_back(per_ray_section(runs));
+    c.sections.push_back(parts_section(runs, "energy by part", "energy/"));
+    c.sections.push_back(parts_section(runs, "area by part", "area/"));
     const auto unwanted = [&](const Row& row) {
         return !has_any(row) ||
                (!keys.empty() && std::none_of(keys.begin(), keys.end(), [&](const std::string& k) {

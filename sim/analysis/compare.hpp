@@ -42,7 +42,8 @@ struct SetupDifference {
 struct Comparison {
     std::vector<std::string> runs;  ///< the files, as given
     std::vector<SetupDifference> differences;
-    std::vector<Section> sections;  ///< summary, stalls, FU utilisation, traffic, per ray
+    std::vector<Section> sections;  ///< summary, stalls, FU utilisation, traffic, per ray,
+                                    ///< energy and area by part
     /// images[i - 1]: run i's image against run 0's; absent when neither names an image.
     std::vector<std::optional<ImageDifference>> images;
     Row host;  ///< host wall time of the kernel run: shown apart, never as a result

@@ -279,7 +279,9 @@ nlohmann::ordered_json converge_document(const ConvergeOptions& o, const Converg
     }
     Json& config = doc["config"];
     for (const timing::ConfigField& field : timing::config_fields(o.base.chip))
-        config[field.key] = field.is_bool ? Json(field.value != 0) : Json(field.value);
+        config[field.key] = field.is_real   ? Json(field.real)
+                            : field.is_bool ? Json(field.value != 0)
+                                            : Json(field.value);
     doc["reference"] = run_json(result.reference);
     doc["reference"]["seed"] = o.base.seed + 1;
     doc["runs"] = Json::array();

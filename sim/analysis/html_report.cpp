@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <utility>
 
@@ -205,7 +207,11 @@ void cards(Page& page, const StatsFile& run) {
                          {"chip/dram/bandwidth_gbps", "DRAM bandwidth", 1, " GB/s"},
                          {"rays/total", "rays", 1, ""},
                          {"traversal/nodes_per_ray", "nodes per ray", 1, ""},
-                         {"traversal/triangles_per_ray", "triangles per ray", 1, ""}};
+                         {"traversal/triangles_per_ray", "triangles per ray", 1, ""},
+                         {"energy/total", "energy per frame", 1e3, " mJ"},
+                         {"energy/average_watts", "average power", 1, " W"},
+                         {"energy/mrays_per_joule", "M rays per joule", 1, ""},
+                         {"area/total", "chip area", 1, " mm&sup2;"}};
     page.body << "<section class=\"cards\">\n";
     for (const Card& card : list)
         if (const auto value = run.stat(card.key)) {
@@ -324,6 +330,58 @@ void cycles_charts(Page& page, const StatsFile& run) {
     page.chart(stalls);
     page.chart(fu);
     page.body << "</div>\n";
+}
+
+/// The energy and area estimate (docs/energy.md): energy by part as a chart, area by part as a
+/// chart and a table with each part's share.
+void energy_and_area(Page& page, const StatsFile& run) {
+    const auto total = run.stat("energy/total");
+    const auto area_total = run.stat("area/total");
+    if (!total || !area_total) return;
+    const std::set<std::string, std::less<>> totals = {
+        "energy/total",   "energy/average_watts", "energy/mrays_per_joule",
+        "energy/per_ray", "energy/per_pixel",     "area/total"};
+    Chart energy{.title = "Energy by part (share of the frame's energy)",
+                 .horizontal = true,
+                 .percent = true,
+                 .tall = true};
+    Chart area{.title = "Area by part (share of the chip)", .horizontal = true, .percent = true};
+    Json energy_shares = Json::array(), area_shares = Json::array();
+    std::vector<std::pair<std::string, double>> areas;
+    for (const auto& [name, value] : run.stats) {
+        if (totals.contains(name)) continue;
+        if (name.starts_with("energy/") && *total > 0) {
+            energy.labels.push_back(name.substr(7));
+            energy_shares.push_back(100 * value / *total);
+        } else if (name.starts_with("area/") && *area_total > 0) {
+            area.labels.push_back(name.substr(5));
+            area_shares.push_back(100 * value / *area_total);
+            areas.emplace_back(name.substr(5), value);
+        }
+    }
+    energy.add("energy", energy_shares);
+    area.add("area", area_shares);
+    page.body << fmt::format(
+        "<h2>Energy and area</h2>\n<p class=\"note\">A 65 nm estimate from "
+        "the run's event counts and the configuration's [energy] and [area] "
+        "costs (docs/energy.md): {} mJ per frame{}, {} W average, {} mm&sup2;."
+        "</p>\n<div class=\"charts\">\n",
+        readable(*total * 1e3),
+        run.stat("energy/per_ray")
+            ? fmt::format(", {} nJ per ray", readable(*run.stat("energy/per_ray") * 1e9))
+            : "",
+        readable(run.stat("energy/average_watts").value_or(0)), readable(*area_total));
+    page.chart(energy);
+    page.chart(area);
+    page.body << "</div>\n<table><tr><th>part</th><th class=\"num\">area (mm&sup2;)</th>"
+                 "<th class=\"num\">share</th></tr>\n";
+    for (const auto& [part, mm2] : areas)
+        page.body << fmt::format("<tr><td class=\"code\">{}</td><td class=\"num\">{}</td>{}</tr>\n",
+                                 escape(part), readable(mm2),
+                                 share_cell(*area_total > 0 ? mm2 / *area_total : 0));
+    page.body << fmt::format("<tr><td>total</td><td class=\"num\">{}</td><td></td></tr>\n"
+                             "</table>\n",
+                             readable(*area_total));
 }
 
 void traffic(Page& page, const StatsFile& run) {
@@ -601,6 +659,7 @@ std::string report_page(const StatsFile& run, const std::string& chart_js) {
     }
     cycles_charts(page, run);
     traffic(page, run);
+    energy_and_area(page, run);
     timeline(page, run);
     profile(page, run);
     if (!run.stat("chip/cycles"))
@@ -672,6 +731,10 @@ std::string comparison_page(const std::vector<StatsFile>& runs, const Comparison
         page.chart(grouped(c, *s, "Functional-unit utilisation", false, 100));
     if (const Section* s = find_section(c, "per ray"))
         page.chart(grouped(c, *s, "Per ray, relative to A", true));
+    if (const Section* s = find_section(c, "energy by part"))
+        page.chart(grouped(c, *s, "Energy by part (J)", false));
+    if (const Section* s = find_section(c, "area by part"))
+        page.chart(grouped(c, *s, "Area by part (mm²)", false));
     if (const Section* s = find_section(c, "traffic by region and level")) {
         Section dram{"dram", {}};
         for (const Row& row : s->rows)
@@ -1000,6 +1063,72 @@ std::string sample_check_page(const Json& doc, const std::string& chart_js) {
     return page.finish("tpsim sample-check: " + scene, chart_js);
 }
 
+/// The sweep's trade-off between speed and energy: every finished job as a point (frame time,
+/// energy per frame), the Pareto front (no other job both faster and cheaper) joined by a line;
+/// one chart per scene (when the scene is an axis). Needs the columns of chip/frame_seconds and
+/// energy/total (the default columns have both).
+void pareto_charts(Page& page, const Json& doc, size_t scene_axis) {
+    const Json& columns = doc["columns"];
+    const auto column_of = [&](std::string_view stat) {
+        for (size_t c = 0; c < columns.size(); ++c)
+            if (columns[c].value("stat", "") == stat) return c;
+        return columns.size();
+    };
+    const size_t time = column_of("chip/frame_seconds"), energy = column_of("energy/total");
+    if (time == columns.size() || energy == columns.size()) return;
+    const std::vector<std::string> axes = doc["axes"].get<std::vector<std::string>>();
+    const auto text = [](const Json& value) {
+        return value.is_string() ? value.get<std::string>() : value.dump();
+    };
+    struct Point {
+        double ms, mj;
+        std::string label;
+    };
+    std::vector<std::pair<std::string, std::vector<Point>>> scenes;  // in row order
+    for (const Json& row : doc["rows"]) {
+        const Json& t = row["stats"][time];
+        const Json& e = row["stats"][energy];
+        if (!t.is_number() || !e.is_number()) continue;
+        const std::string scene = scene_axis < axes.size() ? text(row["values"][scene_axis]) : "";
+        std::string label;
+        for (size_t a = 0; a < axes.size(); ++a)
+            if (a != scene_axis)
+                label += (label.empty() ? "" : ", ") + axes[a] + "=" + text(row["values"][a]);
+        auto found = std::find_if(scenes.begin(), scenes.end(),
+                                  [&](const auto& s) { return s.first == scene; });
+        if (found == scenes.end()) found = scenes.insert(scenes.end(), {scene, {}});
+        found->second.push_back({t.get<double>() * 1e3, e.get<double>() * 1e3,
+                                 label.empty() ? row.value("id", "") : label});
+    }
+    if (scenes.empty()) return;
+    page.body << "<h2>Frame time against energy</h2>\n<p class=\"note\">Each point is a job; the "
+                 "line joins the Pareto front, the jobs no other job beats on both frame time "
+                 "and energy per frame (docs/energy.md).</p>\n<div class=\"charts\">\n";
+    for (auto& [scene, points] : scenes) {
+        Chart chart{.type = "scatter",
+                    .title =
+                        "Pareto: frame time vs energy" + (scene.empty() ? "" : " (" + scene + ")"),
+                    .unit = "energy per frame (mJ)",
+                    .x_title = "frame time (ms)"};
+        Json all = Json::array(), front = Json::array();
+        for (const Point& p : points)
+            all.push_back({{"x", p.ms}, {"y", p.mj}, {"label", p.label}});
+        std::stable_sort(points.begin(), points.end(), [](const Point& a, const Point& b) {
+            return a.ms < b.ms || (a.ms == b.ms && a.mj < b.mj);
+        });
+        double cheapest = std::numeric_limits<double>::infinity();
+        for (const Point& p : points)
+            if (p.mj < cheapest) {  // faster ones all cost more: this one is on the front
+                cheapest = p.mj;
+                front.push_back({{"x", p.ms}, {"y", p.mj}, {"label", p.label}});
+            }
+        chart.add("jobs", all);
+        chart.add("Pareto front", front, true);
+        page.chart(chart);
+    }
+    page.body << "</div>\n";
+}
+
 std::string sweep_page(const Json& doc, const std::string& chart_js) {
     Page page;
     const auto text = [](const Json& value) {
@@ -1093,6 +1222,7 @@ std::string sweep_page(const Json& doc, const std::string& chart_js) {
         }
     }
     if (x_axis < axes.size()) page.body << "</div>\n";
+    pareto_charts(page, doc, scene_axis);
 
     page.body << "<h2>Every job</h2>\n<table><tr><th>id</th>";
     for (const std::string& axis : axes)

@@ -284,9 +284,9 @@ std::string chip_text(const render::RenderOptions& base) {
     const std::vector<timing::ConfigField> defaults = timing::config_fields({});
     const std::vector<timing::ConfigField> fields = timing::config_fields(base.chip);
     for (size_t i = 0; i < fields.size(); ++i)
-        if (fields[i].value != defaults[i].value)
-            changed +=
-                fmt::format("{}{}={}", changed.empty() ? "" : ", ", fields[i].key, fields[i].value);
+        if (fields[i] != defaults[i])
+            changed += fmt::format("{}{}={}", changed.empty() ? "" : ", ", fields[i].key,
+                                   fields[i].text());
     return fmt::format("{} TMs x {} TPs, {}", base.chip.chip.num_tms, base.chip.chip.tps_per_tm,
                        changed.empty() ? "the default chip" : "the default chip but " + changed);
 }
@@ -398,7 +398,10 @@ nlohmann::ordered_json sample_check_document(const SampleCheckOptions& o,
     const std::vector<timing::ConfigField> defaults = timing::config_fields({});
     const std::vector<timing::ConfigField> fields = timing::config_fields(o.base.chip);
     for (size_t i = 0; i < fields.size(); ++i)
-        if (fields[i].value != defaults[i].value) config[fields[i].key] = fields[i].value;
+        if (fields[i] != defaults[i])
+            config[fields[i].key] = fields[i].is_real   ? Json(fields[i].real)
+                                    : fields[i].is_bool ? Json(fields[i].value != 0)
+                                                        : Json(fields[i].value);
     doc["config_changes"] = config;
     doc["width"] = r.width;
     doc["height"] = r.height;

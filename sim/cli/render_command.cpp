@@ -141,6 +141,7 @@ int run_render(RenderCommandOptions& o) {
     render::print_summary(options, result, statistics, std::cout);
     fmt::print("image    {}\n", output.string());
     render::print_traffic(snapshot, options.chip.l2.line_bytes, std::cout);
+    render::print_energy(snapshot, std::cout);
     print_kernel_output(result.output, "\nkernel output (by thread):\n");
     if (result.profile) {
         fmt::print("\n");

@@ -3,11 +3,13 @@
 #include <cmath>
 
 #include <algorithm>
+#include <optional>
 #include <ostream>
 
 #include <fmt/format.h>
 #include <fmt/ostream.h>
 
+#include "sim/energy/energy.hpp"
 #include "sim/render/profile.hpp"
 #include "sim/render/timing_run.hpp"
 #include "sim/stats/thousands.hpp"
@@ -62,10 +64,9 @@ std::string describe_config(const timing::ChipConfig& chip) {
     const std::vector<timing::ConfigField> defaults = timing::config_fields({});
     const std::vector<timing::ConfigField> fields = timing::config_fields(chip);
     for (size_t i = 0; i < fields.size(); ++i)
-        if (fields[i].value != defaults[i].value)
+        if (fields[i] != defaults[i])
             changed += fmt::format("{}{}={}", changed.empty() ? "" : ", ", fields[i].key,
-                                   fields[i].is_bool ? (fields[i].value ? "true" : "false")
-                                                     : std::to_string(fields[i].value));
+                                   fields[i].text());
     return changed.empty() ? "the defaults (configs/trax.toml)"
                            : "the defaults (configs/trax.toml) except " + changed;
 }
@@ -116,6 +117,30 @@ void print_traffic(const stats::Snapshot& snapshot, uint32_t line_bytes, std::os
                    count_text(l2_reads), percent_text(get(region, "l2/hits"), l2_reads),
                    bytes_text(read_bytes), bytes_text(written_bytes), bytes_text(store_payload));
     }
+}
+
+void print_energy(const stats::Snapshot& snapshot, std::ostream& out) {
+    const auto has = [&](std::string_view name) {
+        return std::any_of(snapshot.values().begin(), snapshot.values().end(),
+                           [&](const stats::Value& v) { return v.name == name; });
+    };
+    if (!has("energy/total")) return;
+    const double joules = snapshot.value("energy/total");
+    const double area = snapshot.value("area/total");
+    fmt::print(out, "\nenergy   {:<16} {:>12} {:>7} {:>13} {:>7}\n", "part", "energy", "share",
+               "area", "share");
+    const auto row = [&](std::string_view name, double j, std::optional<double> mm2) {
+        fmt::print(out, "         {:<16} {:>9.4f} mJ {:>7} {:>13} {:>7}\n", name, j * 1e3,
+                   percent_text(j, joules),
+                   mm2 ? fmt::format("{:.3f} mm^2", *mm2) : std::string("-"),
+                   mm2 ? percent_text(*mm2, area) : "-");
+    };
+    for (const energy::Part& part : energy::estimate(timing::ChipConfig{}, {}).parts) {
+        const std::string area_key = "area/" + part.name;
+        row(part.name, snapshot.value("energy/" + part.name),
+            has(area_key) ? std::optional<double>(snapshot.value(area_key)) : std::nullopt);
+    }
+    row("total", joules, area);
 }
 
 void register_stats(const RenderResult& r, stats::Registry& reg) {
@@ -195,6 +220,14 @@ void register_stats(const RenderResult& r, stats::Registry& reg) {
             if (r.instructions.per_op[op] != 0)
                 reg.add_counter(fmt::format("instructions/op/{}", isa::info(isa::Op(op)).mnemonic),
                                 r.instructions.per_op[op], "instructions with this opcode");
+        const energy::RegisterAccesses rf = energy::register_accesses(r.instructions.per_op);
+        number(
+            "registers/reads", [rf] { return rf.reads; },
+            "register-file reads: the source registers of every executed instruction", "accesses");
+        number(
+            "registers/writes", [rf] { return rf.writes; },
+            "register-file writes: the destination register of every executed instruction",
+            "accesses");
     }
     if (r.timing) {
         r.timing->chip->register_stats(reg);
@@ -203,6 +236,7 @@ void register_stats(const RenderResult& r, stats::Registry& reg) {
                 "chip/rays_per_second", {"rays/total", "chip/frame_seconds"},
                 [](std::span<const double> v) { return v[1] > 0 ? v[0] / v[1] : 0.0; },
                 "rays traced per simulated second (rays/total / chip/frame_seconds)", "rays/s");
+        energy::register_stats(r.timing->config, reg);
     }
     number(
         "host/load_seconds", [&r] { return r.load_seconds; }, "scene load and import time", "s");
@@ -335,6 +369,19 @@ void print_summary(const RenderOptions& options, const RenderResult& r,
                                                         double(r.traversal.rays()) / seconds / 1e6)
                                           : "");
     }
+    if (r.timing) {  // the cycle-level engine registered the energy estimate
+        const stats::Snapshot& s = statistics.values;
+        const auto get = [&](std::string_view name) { return s.value(name); };
+        const bool rays = r.traversal.rays() > 0;
+        fmt::print(out,
+                   "energy   {}{:.3f} mJ per frame{}, {:.2f} W average at {} MHz{} (65 nm "
+                   "estimate, docs/energy.md)\n",
+                   statistics.estimate ? "~" : "", get("energy/total") * 1e3,
+                   rays ? fmt::format(" = {:.2f} nJ per ray", get("energy/per_ray") * 1e9) : "",
+                   get("energy/average_watts"), options.chip.chip.clock_mhz,
+                   rays ? fmt::format(", {:.1f} M rays/J", get("energy/mrays_per_joule")) : "");
+        fmt::print(out, "area     {:.2f} mm^2 (65 nm)\n", get("area/total"));
+    }
     if (r.instructions.total > 0)
         fmt::print(out,
                    "run      {} instructions in {:.3f} s = {:.1f} M simulated instructions/s\n",
@@ -381,7 +428,9 @@ nlohmann::ordered_json stats_document(const RenderOptions& options, const Render
     if (!outputs.heatmap.empty()) run["heatmap"] = relative(outputs.heatmap);
     nlohmann::ordered_json& config = doc["config"];
     for (const timing::ConfigField& field : timing::config_fields(options.chip)) {
-        if (field.is_bool)
+        if (field.is_real)
+            config[field.key] = field.real;
+        else if (field.is_bool)
             config[field.key] = field.value != 0;
         else
             config[field.key] = field.value;

@@ -49,6 +49,10 @@ std::vector<std::string> region_names(const stats::Snapshot& snapshot);
 /// bytes read and written (whole lines of `line_bytes`) and the store payload they carried.
 void print_traffic(const stats::Snapshot& snapshot, uint32_t line_bytes, std::ostream& out);
 
+/// The energy and area table: per part of the chip (energy/<part>, area/<part>), its energy
+/// over the run and area, each with its share of the total. Nothing without energy statistics.
+void print_energy(const stats::Snapshot& snapshot, std::ostream& out);
+
 /// What a render wrote beside its statistics, named in the statistics file.
 struct OutputPaths {
     std::filesystem::path image;    ///< the rendered image

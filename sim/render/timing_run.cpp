@@ -23,6 +23,7 @@ std::shared_ptr<TimingRun> run_timing(const core::Program& program, image::Memor
     timing::ChipLayout layout = chip_layout(image, machine);
     layout.profile = options.profile;
     run->chip = std::make_unique<timing::Chip>(chip, *run->source, layout);
+    run->config = chip;
     timing::Chip& model = *run->chip;
     // --threads unset: sampled runs stay on one host thread (their units of a few thousand
     // cycles are too short to share), full runs choose as they go.

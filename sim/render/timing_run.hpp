@@ -23,6 +23,7 @@ struct TimingRun {
     std::unique_ptr<core::Machine> machine;
     std::unique_ptr<timing::MachineSource> source;
     std::unique_ptr<timing::Chip> chip;
+    timing::ChipConfig config;  ///< the chip's configuration, for the energy and area estimate
     std::unique_ptr<Timeline> timeline;  ///< none for a sampled run
     InstructionCounts instructions;
     /// A sampled run: what it did, and what it measured for stats::estimate().

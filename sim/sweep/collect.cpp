@@ -39,7 +39,12 @@ std::vector<Column> default_columns() {
             {"l1_hit_rate", "chip/l1/hit_rate"},
             {"l2_hit_rate", "chip/l2/hit_rate"},
             {"dram_bytes_read", "dram/bytes_read"},
-            {"dram_bytes_written", "dram/bytes_written"}};
+            {"dram_bytes_written", "dram/bytes_written"},
+            {"frame_seconds", "chip/frame_seconds"},
+            {"energy_joules", "energy/total"},
+            {"watts", "energy/average_watts"},
+            {"mrays_per_joule", "energy/mrays_per_joule"},
+            {"area_mm2", "area/total"}};
 }
 
 Table collect(const Sweep& sweep, const std::filesystem::path& dir,

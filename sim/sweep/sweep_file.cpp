@@ -65,10 +65,8 @@ std::string changed_fields(const timing::ChipConfig& chip) {
     const std::vector<timing::ConfigField> fields = timing::config_fields(chip);
     std::string lines;
     for (size_t f = 0; f < fields.size(); ++f)
-        if (fields[f].value != defaults[f].value)
-            lines += fmt::format("{} = {}\n", fields[f].key,
-                                 fields[f].is_bool ? (fields[f].value ? "true" : "false")
-                                                   : std::to_string(fields[f].value));
+        if (fields[f] != defaults[f])
+            lines += fmt::format("{} = {}\n", fields[f].key, fields[f].text());
     return lines;
 }
 
@@ -138,7 +136,8 @@ private:
         if (const auto s = node.value_exact<std::string>()) return {*s, line};
         if (const auto i = node.value_exact<int64_t>()) return {*i, line};
         if (const auto b = node.value_exact<bool>()) return {*b, line};
-        fail(line, fmt::format("{} must be a string, an integer or true/false, or an array of "
+        if (const auto d = node.value_exact<double>()) return {*d, line};
+        fail(line, fmt::format("{} must be a string, a number or true/false, or an array of "
                                "them (an axis)",
                                name));
     }
@@ -258,10 +257,15 @@ private:
             run.timing = one_of(name, v, {"cycle", "sampled", "none"});
         } else {
             const timing::ConfigField field = *config_field(name);
-            if (field.is_bool ? !v.value.is_boolean() : !v.value.is_number_integer())
-                fail(v.line,
-                     fmt::format("{} must be {}, got {}", name,
-                                 field.is_bool ? "true or false" : "an integer", v.value.dump()));
+            const bool ok = field.is_bool   ? v.value.is_boolean()
+                            : field.is_real ? v.value.is_number()
+                                            : v.value.is_number_integer();
+            if (!ok)
+                fail(v.line, fmt::format("{} must be {}, got {}", name,
+                                         field.is_bool   ? "true or false"
+                                         : field.is_real ? "a number"
+                                                         : "an integer",
+                                         v.value.dump()));
             // Ranges and cross-field rules are checked with the job's whole configuration.
             if (chip_keys) chip_keys->emplace_back(name, v);
         }

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <bit>
 #include <charconv>
+#include <cmath>
 #include <optional>
 #include <type_traits>
 
@@ -82,19 +83,67 @@ template <class Config, class Visit> void for_each_field(Config& c, Visit&& visi
     visit("global_registers.latency", c.global_registers.latency, Range{1, kMaxLatency});
     visit("global_registers.per_cycle", c.global_registers.per_cycle, Range{1, 1024});
     visit("global_registers.link_latency", c.global_registers.link_latency, Range{1, kMaxLatency});
+    // Costs are real numbers >= 0 (0 leaves a part out of the estimate); the exponents of the
+    // SRAM scaling rule stay in 0..2 (CACTI's fitted ones are below 1).
+    constexpr Range kCost{0, 1000000000};
+    constexpr Range kExponent{0, 2};
+    visit("energy.int_alu_pj", c.energy.int_alu_pj, kCost);
+    visit("energy.int_muldiv_pj", c.energy.int_muldiv_pj, kCost);
+    visit("energy.fp_add_pj", c.energy.fp_add_pj, kCost);
+    visit("energy.fp_mul_pj", c.energy.fp_mul_pj, kCost);
+    visit("energy.fp_divsqrt_pj", c.energy.fp_divsqrt_pj, kCost);
+    visit("energy.fp_misc_pj", c.energy.fp_misc_pj, kCost);
+    visit("energy.branch_pj", c.energy.branch_pj, kCost);
+    visit("energy.load_store_pj", c.energy.load_store_pj, kCost);
+    visit("energy.atomic_pj", c.energy.atomic_pj, kCost);
+    visit("energy.register_access_pj", c.energy.register_access_pj, kCost);
+    visit("energy.local_store_access_pj", c.energy.local_store_access_pj, kCost);
+    visit("energy.icache_fetch_pj", c.energy.icache_fetch_pj, kCost);
+    visit("energy.l1_access_pj", c.energy.l1_access_pj, kCost);
+    visit("energy.l2_access_pj", c.energy.l2_access_pj, kCost);
+    visit("energy.sram_size_exponent", c.energy.sram_size_exponent, kExponent);
+    visit("energy.sram_bank_exponent", c.energy.sram_bank_exponent, kExponent);
+    visit("energy.dram_activate_pj", c.energy.dram_activate_pj, kCost);
+    visit("energy.dram_read_pj", c.energy.dram_read_pj, kCost);
+    visit("energy.dram_write_pj", c.energy.dram_write_pj, kCost);
+    visit("energy.dram_background_mw", c.energy.dram_background_mw, kCost);
+    visit("area.int_alu_um2", c.area.int_alu_um2, kCost);
+    visit("area.int_muldiv_um2", c.area.int_muldiv_um2, kCost);
+    visit("area.fp_add_um2", c.area.fp_add_um2, kCost);
+    visit("area.fp_mul_um2", c.area.fp_mul_um2, kCost);
+    visit("area.fp_divsqrt_um2", c.area.fp_divsqrt_um2, kCost);
+    visit("area.fp_misc_um2", c.area.fp_misc_um2, kCost);
+    visit("area.branch_um2", c.area.branch_um2, kCost);
+    visit("area.load_store_um2", c.area.load_store_um2, kCost);
+    visit("area.atomic_um2", c.area.atomic_um2, kCost);
+    visit("area.register_file_um2", c.area.register_file_um2, kCost);
+    visit("area.local_store_um2", c.area.local_store_um2, kCost);
+    visit("area.icache_um2", c.area.icache_um2, kCost);
+    visit("area.l1_um2", c.area.l1_um2, kCost);
+    visit("area.l2_um2", c.area.l2_um2, kCost);
+    visit("area.sram_size_exponent", c.area.sram_size_exponent, kExponent);
+    visit("area.sram_bank_exponent", c.area.sram_bank_exponent, kExponent);
 }
 
 template <class T> constexpr bool kIsBool = std::is_same_v<std::remove_cvref_t<T>, bool>;
+template <class T> constexpr bool kIsReal = std::is_same_v<std::remove_cvref_t<T>, double>;
 
 std::string range_text(bool is_bool, Range r) {
     return is_bool ? "true or false" : fmt::format("{}..{}", r.min, r.max);
 }
 
-// Sets `key` to a value already parsed as bool or integer; returns false if no such key.
+/// A value read from TOML or an override, as whichever of the three kinds it parsed as.
+struct Parsed {
+    std::optional<bool> as_bool;
+    std::optional<int64_t> as_int;
+    std::optional<double> as_real;  ///< also set for an integer: a real field takes both
+};
+
+// Sets `key` to a parsed value; returns false if no such key.
 // `where` prefixes every error ("file:line" or "override 'k=v'").
-bool assign(ChipConfig& config, std::string_view key, std::optional<bool> as_bool,
-            std::optional<int64_t> as_int, std::string_view where) {
+bool assign(ChipConfig& config, std::string_view key, const Parsed& value, std::string_view where) {
     bool found = false;
+    const auto [as_bool, as_int, as_real] = value;
     for_each_field(config, [&](std::string_view name, auto& field, Range range) {
         if (name != key) return;
         found = true;
@@ -102,6 +151,14 @@ bool assign(ChipConfig& config, std::string_view key, std::optional<bool> as_boo
             if (!as_bool)
                 throw ConfigError(fmt::format("{}: {} must be true or false", where, key));
             field = *as_bool;
+        } else if constexpr (kIsReal<decltype(field)>) {
+            if (!as_real || !std::isfinite(*as_real))
+                throw ConfigError(fmt::format("{}: {} must be a number in {}", where, key,
+                                              range_text(false, range)));
+            if (*as_real < range.min || *as_real > range.max)
+                throw ConfigError(fmt::format("{}: {} = {} is out of range; allowed {}", where, key,
+                                              *as_real, range_text(false, range)));
+            field = *as_real;
         } else {
             if (!as_int)
                 throw ConfigError(fmt::format("{}: {} must be an integer in {}", where, key,
@@ -143,11 +200,11 @@ void load_table(ChipConfig& config, const toml::table& table, const std::string&
             load_table(config, *sub, key, source_name);
             continue;
         }
-        std::optional<bool> as_bool;
-        std::optional<int64_t> as_int;
-        if (auto b = node.value_exact<bool>()) as_bool = *b;
-        if (auto i = node.value_exact<int64_t>()) as_int = *i;
-        if (!assign(config, key, as_bool, as_int, where)) unknown_key(where, key);
+        Parsed value;
+        if (auto b = node.value_exact<bool>()) value.as_bool = *b;
+        if (auto i = node.value_exact<int64_t>()) value.as_int = *i;
+        if (auto r = node.value<double>()) value.as_real = *r;  // a float, or an integer
+        if (!assign(config, key, value, where)) unknown_key(where, key);
     }
 }
 
@@ -174,7 +231,11 @@ void validate_cache(const CacheConfig& c, std::string_view name) {
 void validate(const ChipConfig& config) {
     // Ranges first (a config built in code may not have come through the loader).
     for_each_field(config, [](std::string_view name, const auto& field, Range range) {
-        if constexpr (!kIsBool<decltype(field)>)
+        if constexpr (kIsReal<decltype(field)>)
+            check(std::isfinite(field) && field >= range.min && field <= range.max,
+                  fmt::format("{} = {} is out of range; allowed {}", name, field,
+                              range_text(false, range)));
+        else if constexpr (!kIsBool<decltype(field)>)
             check(field >= range.min && field <= range.max,
                   fmt::format("{} = {} is out of range; allowed {}", name, field,
                               range_text(false, range)));
@@ -266,19 +327,24 @@ void apply_override(ChipConfig& config, std::string_view assignment) {
     };
     const std::string_view key = trim(assignment.substr(0, eq));
     const std::string_view text = trim(assignment.substr(eq + 1));
-    std::optional<bool> as_bool;
-    std::optional<int64_t> as_int;
-    if (text == "true") as_bool = true;
-    if (text == "false") as_bool = false;
+    Parsed value;
+    if (text == "true") value.as_bool = true;
+    if (text == "false") value.as_bool = false;
     int64_t number = 0;
     const bool hex = text.starts_with("0x");
     const std::string_view digits = hex ? text.substr(2) : text;
     const auto [end, ec] =
         std::from_chars(digits.data(), digits.data() + digits.size(), number, hex ? 16 : 10);
-    if (ec == std::errc{} && end == digits.data() + digits.size() && !digits.empty())
-        as_int = number;
+    if (ec == std::errc{} && end == digits.data() + digits.size() && !digits.empty()) {
+        value.as_int = number;
+        value.as_real = double(number);
+    }
+    double real = 0;
+    const auto [real_end, real_ec] = std::from_chars(text.data(), text.data() + text.size(), real);
+    if (!hex && real_ec == std::errc{} && real_end == text.data() + text.size() && !text.empty())
+        value.as_real = real;
     ChipConfig updated = config;
-    if (!assign(updated, key, as_bool, as_int, where)) unknown_key(where, key);
+    if (!assign(updated, key, value, where)) unknown_key(where, key);
     try {
         validate(updated);
     } catch (const ConfigError& e) {
@@ -307,9 +373,18 @@ std::string to_toml(const ChipConfig& config) {
 std::vector<ConfigField> config_fields(const ChipConfig& config) {
     std::vector<ConfigField> fields;
     for_each_field(config, [&](std::string_view name, const auto& field, Range) {
-        fields.push_back({std::string(name), uint32_t(field), kIsBool<decltype(field)>});
+        if constexpr (kIsReal<decltype(field)>)
+            fields.push_back({std::string(name), 0, false, true, field});
+        else
+            fields.push_back({std::string(name), uint32_t(field), kIsBool<decltype(field)>});
     });
     return fields;
+}
+
+std::string ConfigField::text() const {
+    if (is_real) return fmt::format("{}", real);
+    if (is_bool) return value ? "true" : "false";
+    return std::to_string(value);
 }
 
 }  // namespace tpsim::timing

@@ -117,6 +117,88 @@ struct GlobalRegisterConfig {
     bool operator==(const GlobalRegisterConfig&) const = default;
 };
 
+/// [energy] What each event costs, in picojoules, at 65 nm (the node of the TRaX figures), for
+/// the post-run estimate in sim/energy (docs/energy.md has every source and rule). The SRAM
+/// costs are those of the default chip's geometry; sim/energy scales them to the configured
+/// size and banks by the power law fitted to the same CACTI table.
+struct EnergyConfig {
+    // Per operation issued to a pool: simtrax samples/configs/default.config (65 nm Synopsys
+    // DesignWare units, Spjut et al. TCAD 2009, Kopta et al. HPG 2013), its last column.
+    double int_alu_pj = 0.101;     ///< INTADD (and BITWISE) 0.101
+    double int_muldiv_pj = 2.97;   ///< INTMUL 2.97
+    double fp_add_pj = 0.719;      ///< FPADD 0.719
+    double fp_mul_pj = 3.15;       ///< FPMUL 3.15 (a fused multiply-add costs one multiply)
+    double fp_divsqrt_pj = 45.55;  ///< FPINV 45.55 (TRaX's inverse/sqrt unit)
+    double fp_misc_pj = 0.13;      ///< FPMIN and FPCMP 0.13
+    double branch_pj = 0.13;       ///< BLT 0.13
+    double load_store_pj = 0.101;  ///< address generation: an integer add (INTADD)
+    double atomic_pj = 0.101;      ///< the request's increment: an integer add (INTADD)
+    /// Per register read or write: simtrax SimpleRegisterFile.cc, 0.00789613 nJ (CACTI, 65 nm,
+    /// a 128-entry 32-bit file).
+    double register_access_pj = 7.89613;
+    /// Per local-store load or store: CACTI 65 nm, 4 KiB, 1 bank, 4 B lines, 0.015990 nJ
+    /// (simtrax samples/configs/icacheparams.txt; includes a tag array the store does not need).
+    double local_store_access_pj = 15.990;
+    /// Per instruction fetch: CACTI 65 nm I-cache, 4 KiB, 16 banks, 4 B lines, 0.013490 nJ
+    /// (simtrax icacheparams.txt; TRaX: one I-cache per 16 threads).
+    double icache_fetch_pj = 13.490;
+    /// Per L1 access (load, store, line fill): CACTI 65 nm, 32 KiB, 8 banks, 64 B lines,
+    /// 0.220453 nJ (simtrax samples/configs/dcacheparams.txt).
+    double l1_access_pj = 220.453;
+    /// Per L2 access (line request, store, line fill): CACTI 65 nm, 512 KiB, 16 banks, 64 B
+    /// lines, 0.611974 nJ (dcacheparams.txt).
+    double l2_access_pj = 611.974;
+    /// SRAM energy per access grows as (size / default size)^this and (banks / default
+    /// banks)^sram_bank_exponent: least-squares fit to dcacheparams.txt (64 B lines, 8 KiB to
+    /// 4 MiB, 4 to 64 banks), within -30 % / +23 % of every entry.
+    double sram_size_exponent = 0.355;
+    double sram_bank_exponent = 0.176;  ///< see sram_size_exponent
+    /// DRAM, per rank of four x16 1 Gb DDR3 devices (a 64-bit channel), from the IDD currents
+    /// of simtrax samples/configs/usimm_configs/1Gb_x16_amd2GHz.vi with USIMM's power model
+    /// (Micron TN-41-01): per ACT (and its PRE) 4 x (IDD0 tRC - IDD3N tRAS - IDD2N (tRC - tRAS))
+    /// x VDD = 4 x 3.83 nJ.
+    double dram_activate_pj = 15330;
+    /// Per 64 B line read: 4 x ((IDD4R - IDD3N) VDD + 32 mW read termination) x 2 ns.
+    double dram_read_pj = 2452;
+    /// Per 64 B line written: 4 x (IDD4W - IDD3N) VDD x 2 ns.
+    double dram_write_pj = 2196;
+    /// Background power per channel, in milliwatts: 4 x (IDD2N VDD precharge standby + (IDD5 -
+    /// IDD3N) VDD tRFC / tREFI refresh) = 4 x 109.1 mW.
+    double dram_background_mw = 436.4;
+    bool operator==(const EnergyConfig&) const = default;
+};
+
+/// [area] Silicon area of each component, in square micrometres, at 65 nm (docs/energy.md).
+struct AreaConfig {
+    // Per unit of a pool: simtrax samples/configs/default.config and sim/ReadConfig.cc
+    // ("65nm sp"), Synopsys DesignWare.
+    double int_alu_um2 = 450;       ///< INTADD 450
+    double int_muldiv_um2 = 9184;   ///< INTMUL 9184
+    double fp_add_um2 = 3311;       ///< FPADD 3311
+    double fp_mul_um2 = 10327;      ///< FPMUL 10327
+    double fp_divsqrt_um2 = 57936;  ///< FPINV 57936
+    double fp_misc_um2 = 722;       ///< FPMIN / FPCMP 722 (ReadConfig.cc)
+    double branch_um2 = 722;        ///< BLT 722 (ReadConfig.cc: "same as compare")
+    double load_store_um2 = 450;    ///< an integer adder (INTADD)
+    double atomic_um2 = 450;        ///< an integer adder (INTADD)
+    /// Per TP: simtrax SimpleRegisterFile.cc, 0.0147665 mm^2 (128 x 32 bit).
+    double register_file_um2 = 14766.5;
+    /// Per TP: CACTI 65 nm, 4 KiB, 1 bank, 4 B lines, 0.090296 mm^2 (icacheparams.txt).
+    double local_store_um2 = 90296;
+    /// Per I-cache: CACTI 65 nm, 4 KiB, 16 banks, 4 B lines, 0.130596 mm^2 (icacheparams.txt).
+    double icache_um2 = 130596;
+    /// Per L1: CACTI 65 nm, 32 KiB, 8 banks, 64 B lines, 0.775049 mm^2 (dcacheparams.txt).
+    double l1_um2 = 775049;
+    /// Per L2: CACTI 65 nm, 512 KiB, 16 banks, 64 B lines, 5.960245 mm^2 (dcacheparams.txt).
+    double l2_um2 = 5960245;
+    /// SRAM area grows as (size / default size)^this and (banks / default banks)^
+    /// sram_bank_exponent: least-squares fit to dcacheparams.txt as for energy, within
+    /// -48 % / +51 % of every entry.
+    double sram_size_exponent = 0.682;
+    double sram_bank_exponent = 0.446;  ///< see sram_size_exponent
+    bool operator==(const AreaConfig&) const = default;
+};
+
 /// The resolved configuration of one chip.
 struct ChipConfig {
     ChipShape chip;
@@ -127,6 +209,8 @@ struct ChipConfig {
     L2Config l2{{524288, 8, 64, 16, 8, 64}};
     DramConfig dram;
     GlobalRegisterConfig global_registers;
+    EnergyConfig energy;
+    AreaConfig area;
     bool operator==(const ChipConfig&) const = default;
 
     /// Number of L2 caches: one per group of chip.tms_per_l2 TMs.
@@ -162,8 +246,13 @@ std::string to_toml(const ChipConfig& config);
 /// One configurable field's resolved value.
 struct ConfigField {
     std::string key;  ///< e.g. "l1.size_bytes"
-    uint32_t value;   ///< 0 or 1 when is_bool
+    uint32_t value;   ///< 0 or 1 when is_bool; 0 when is_real
     bool is_bool;
+    bool is_real = false;  ///< a real number (energies, areas): `real` holds it
+    double real = 0;
+    /// The value as TOML writes it: "32768", "true", "0.719".
+    std::string text() const;
+    bool operator==(const ConfigField&) const = default;
 };
 /// Every configurable field of `config`, in print order (statistics file, help text, tests).
 std::vector<ConfigField> config_fields(const ChipConfig& config);

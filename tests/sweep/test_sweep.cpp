@@ -179,8 +179,14 @@ TEST_CASE("sweep: bad sweep files are one line naming file:line", "[sweep]") {
     CHECK(error_of(dir, "scene = \"scenes/a.toml\"\n\n[l1]\nsize_bytes = [8192, 3]\n")
               .starts_with(file + ":4: l1.size_bytes = 3 is out of range"));
     CHECK(error_of(dir, "scene = \"scenes/a.toml\"\nl1.size_bytes = [1.5]\n") ==
-          file + ":2: l1.size_bytes must be a string, an integer or true/false, or an array of "
+          file + ":2: l1.size_bytes must be an integer, got 1.5");
+    CHECK(error_of(dir, "scene = \"scenes/a.toml\"\nl1.size_bytes = [{a = 1}]\n") ==
+          file + ":2: l1.size_bytes must be a string, a number or true/false, or an array of "
                  "them (an axis)");
+    CHECK(error_of(dir, "scene = \"scenes/a.toml\"\nenergy.l1_access_pj = [\"big\"]\n") ==
+          file + ":2: energy.l1_access_pj must be a number, got \"big\"");
+    CHECK(error_of(dir, "scene = \"scenes/a.toml\"\nenergy.l1_access_pj = [100, -1.5]\n")
+              .starts_with(file + ":2: energy.l1_access_pj = -1.5 is out of range"));
     CHECK(error_of(dir, "scene = \"scenes/a.toml\"\nl1.size_bytes = [\"big\"]\n") ==
           file + ":2: l1.size_bytes must be an integer, got \"big\"");
     CHECK(error_of(dir, "bvh = [\"sweep\"]\n") ==
@@ -268,10 +274,12 @@ l1.size_bytes = [4096, 8192]
     const std::string csv = table_csv(table, false);
     CHECK(csv.substr(0, csv.find('\n')) ==
           "id,bvh,l1.size_bytes,status,cycles,instructions,rays,l1_hit_rate,l2_hit_rate,"
-          "dram_bytes_read,dram_bytes_written");
+          "dram_bytes_read,dram_bytes_written,frame_seconds,energy_joules,watts,mrays_per_joule,"
+          "area_mm2");
     CHECK(csv.find(sweep.jobs[1].id + ",sweep,8192,ok,480000,2900000,1900,0.94,0.74,520000,"
-                                      "12288\n") != std::string::npos);
-    CHECK(csv.find(sweep.jobs[3].id + ",binned,8192,missing,,,,,,,\n") != std::string::npos);
+                                      "12288,0.00048,0.0016,3.333333,1.1875,1.576586\n") !=
+          std::string::npos);
+    CHECK(csv.find(sweep.jobs[3].id + ",binned,8192,missing,,,,,,,,,,,,\n") != std::string::npos);
     CHECK(table_csv(table, true).find(",host_seconds\n") != std::string::npos);
     const std::string md = table_markdown(table, false);
     CHECK(md.find("| " + sweep.jobs[1].id +

@@ -96,7 +96,7 @@ TEST_CASE("the printed config lists every key and parses back to the same config
         CHECK(text.find(leaf) != std::string::npos);
     }
     CHECK(parse_config(text, "printed") == c);
-    CHECK(fields.size() == 4 + 4 + 9 * 3 + 2 + 2 * 6 + 1 + 15 + 3);
+    CHECK(fields.size() == 4 + 4 + 9 * 3 + 2 + 2 * 6 + 1 + 15 + 3 + 20 + 16);
     // The fields carry the resolved values, bools as 0/1.
     const auto field = [&](std::string_view key) {
         return *std::find_if(fields.begin(), fields.end(),

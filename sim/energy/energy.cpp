@@ -1,0 +1,275 @@
+#include "sim/energy/energy.hpp"
+
+#include <cmath>
+#include <numeric>
+
+#include <fmt/format.h>
+
+#include "isa/isa.hpp"
+
+namespace tpsim::energy {
+
+namespace {
+
+constexpr size_t kPools = size_t(timing::Pool::Count);
+
+/// Like stats::matches, but a segment "tm*" stands for one TM ("tm" and digits) only, so a
+/// chip-wide sum added later ("chip/...") is never counted twice.
+bool source_matches(std::string_view pattern, std::string_view name) {
+    while (true) {
+        const size_t p_end = pattern.find('/');
+        const size_t n_end = name.find('/');
+        const std::string_view p_seg = pattern.substr(0, p_end);
+        const std::string_view n_seg = name.substr(0, n_end);
+        const bool tm = p_seg == "tm*" && n_seg.size() > 2 && n_seg.starts_with("tm") &&
+                        n_seg.find_first_not_of("0123456789", 2) == std::string_view::npos;
+        if (!tm && p_seg != n_seg) return false;
+        if (p_end == std::string_view::npos || n_end == std::string_view::npos)
+            return p_end == n_end;
+        pattern.remove_prefix(p_end + 1);
+        name.remove_prefix(n_end + 1);
+    }
+}
+
+/// The source an input statistic feeds, if any.
+const EventSource* source_of(std::string_view name) {
+    for (const EventSource& source : event_sources())
+        if (source_matches(source.pattern, name)) return &source;
+    return nullptr;
+}
+
+double pj(double picojoules) {
+    return picojoules * 1e-12;
+}
+
+double mm2(double square_micrometres) {
+    return square_micrometres * 1e-6;
+}
+
+}  // namespace
+
+const std::vector<EventSource>& event_sources() {
+    static const std::vector<EventSource> sources = [] {
+        std::vector<EventSource> s;
+        for (size_t p = 0; p < kPools; ++p)
+            s.push_back(
+                {fmt::format("tm*/fu/{}/issued", timing::to_string(timing::Pool(p))), nullptr, p});
+        s.push_back({"registers/reads", &Events::register_reads});
+        s.push_back({"registers/writes", &Events::register_writes});
+        s.push_back({"tm*/local_store/loads", &Events::local_store_accesses});
+        s.push_back({"tm*/local_store/stores", &Events::local_store_accesses});
+        s.push_back({"tm*/icache/fetches", &Events::icache_fetches});
+        for (const char* key : {"reads", "writes", "misses"}) {
+            s.push_back({fmt::format("chip/l1/{}", key), &Events::l1_accesses});
+            s.push_back({fmt::format("chip/l2/{}", key), &Events::l2_accesses});
+        }
+        s.push_back({"dram/activates", &Events::dram_activates});
+        s.push_back({"dram/reads", &Events::dram_reads});
+        s.push_back({"dram/writes", &Events::dram_writes});
+        s.push_back({"chip/cycles", &Events::cycles});
+        return s;
+    }();
+    return sources;
+}
+
+Events events_from(std::span<const std::string> names, std::span<const double> values) {
+    Events events;
+    for (size_t i = 0; i < names.size() && i < values.size(); ++i)
+        if (const EventSource* source = source_of(names[i])) {
+            if (source->count)
+                events.*(source->count) += values[i];
+            else
+                events.fu_issued[source->pool] += values[i];
+        }
+    return events;
+}
+
+double scale_sram(double cost, double size_bytes, double default_size_bytes, double banks,
+                  double default_banks, double size_exponent, double bank_exponent) {
+    return cost * std::pow(size_bytes / default_size_bytes, size_exponent) *
+           std::pow(banks / default_banks, bank_exponent);
+}
+
+double Estimate::joules() const {
+    return std::accumulate(parts.begin(), parts.end(), 0.0,
+                           [](double sum, const Part& p) { return sum + p.joules; });
+}
+
+double Estimate::area_mm2() const {
+    return std::accumulate(parts.begin(), parts.end(), 0.0,
+                           [](double sum, const Part& p) { return sum + p.area_mm2; });
+}
+
+Estimate estimate(const timing::ChipConfig& chip, const Events& events) {
+    const timing::ChipConfig defaults;
+    const timing::EnergyConfig& e = chip.energy;
+    const timing::AreaConfig& a = chip.area;
+    const double tms = chip.chip.num_tms;
+    const double tps = tms * chip.chip.tps_per_tm;
+    const double icaches =
+        tms * double((chip.chip.tps_per_tm + chip.icache.threads_per_icache - 1) /
+                     chip.icache.threads_per_icache);
+    // Every SRAM scales from the geometry its cited figure is for: the default chip's.
+    const auto sram = [](double cost, double size, double default_size, double banks,
+                         double default_banks, double size_exponent, double bank_exponent) {
+        return scale_sram(cost, size, default_size, banks, default_banks, size_exponent,
+                          bank_exponent);
+    };
+    const auto energy_of = [&](double cost, double size, double default_size, double banks,
+                               double default_banks) {
+        return sram(cost, size, default_size, banks, default_banks, e.sram_size_exponent,
+                    e.sram_bank_exponent);
+    };
+    const auto area_of = [&](double cost, double size, double default_size, double banks,
+                             double default_banks) {
+        return sram(cost, size, default_size, banks, default_banks, a.sram_size_exponent,
+                    a.sram_bank_exponent);
+    };
+
+    Estimate out;
+    out.seconds = events.cycles / (double(chip.chip.clock_mhz) * 1e6);
+    const std::array<std::pair<double, double>, kPools> fu_costs = {{
+        {e.int_alu_pj, a.int_alu_um2},
+        {e.int_muldiv_pj, a.int_muldiv_um2},
+        {e.fp_add_pj, a.fp_add_um2},
+        {e.fp_mul_pj, a.fp_mul_um2},
+        {e.fp_divsqrt_pj, a.fp_divsqrt_um2},
+        {e.fp_misc_pj, a.fp_misc_um2},
+        {e.branch_pj, a.branch_um2},
+        {e.load_store_pj, a.load_store_um2},
+        {e.atomic_pj, a.atomic_um2},
+    }};
+    for (size_t p = 0; p < kPools; ++p) {
+        const timing::Pool pool = timing::Pool(p);
+        const std::string name(timing::to_string(pool));
+        out.parts.push_back(
+            {"fu/" + name, fmt::format("{} functional units", name),
+             fmt::format("operations issued x energy.{}_pj", name),
+             fmt::format("units x TMs x area.{}_um2", name),
+             events.fu_issued[p] * pj(fu_costs[p].first),
+             tms * timing::pool_config(chip.fu, pool).count * mm2(fu_costs[p].second)});
+    }
+    out.parts.push_back(
+        {"register_files", "register files", "reads and writes x energy.register_access_pj",
+         "TPs x area.register_file_um2",
+         (events.register_reads + events.register_writes) * pj(e.register_access_pj),
+         tps * mm2(a.register_file_um2)});
+    const double ls = chip.tp.local_store_bytes, ls_default = defaults.tp.local_store_bytes;
+    out.parts.push_back(
+        {"local_stores", "local stores",
+         "loads and stores x energy.local_store_access_pj scaled to tp.local_store_bytes",
+         "TPs x area.local_store_um2 scaled to tp.local_store_bytes",
+         events.local_store_accesses * pj(energy_of(e.local_store_access_pj, ls, ls_default, 1, 1)),
+         tps * mm2(area_of(a.local_store_um2, ls, ls_default, 1, 1))});
+    const double ib = chip.icache.banks, ib_default = defaults.icache.banks;
+    out.parts.push_back(
+        {"icaches", "instruction caches", "fetches x energy.icache_fetch_pj scaled to icache.banks",
+         "I-caches x area.icache_um2 scaled to icache.banks",
+         events.icache_fetches * pj(energy_of(e.icache_fetch_pj, 1, 1, ib, ib_default)),
+         icaches * mm2(area_of(a.icache_um2, 1, 1, ib, ib_default))});
+    const auto cache_part = [&](std::string name, const timing::CacheConfig& c,
+                                const timing::CacheConfig& d, double accesses, double access_pj,
+                                double um2, double count) {
+        return Part{name,
+                    fmt::format("{} caches", name == "l1" ? "L1" : "L2"),
+                    fmt::format("loads, stores and line fills x energy.{0}_access_pj scaled to "
+                                "{0}.size_bytes and {0}.banks",
+                                name),
+                    fmt::format("{0}s x area.{0}_um2 scaled to {0}.size_bytes and {0}.banks", name),
+                    accesses *
+                        pj(energy_of(access_pj, c.size_bytes, d.size_bytes, c.banks, d.banks)),
+                    count * mm2(area_of(um2, c.size_bytes, d.size_bytes, c.banks, d.banks))};
+    };
+    out.parts.push_back(
+        cache_part("l1", chip.l1, defaults.l1, events.l1_accesses, e.l1_access_pj, a.l1_um2, tms));
+    out.parts.push_back(cache_part("l2", chip.l2, defaults.l2, events.l2_accesses, e.l2_access_pj,
+                                   a.l2_um2, chip.num_l2()));
+    // The DRAM figures are per 64-byte line (two 32-byte bursts of a 64-bit rank).
+    const double lines_per_64 = chip.l2.line_bytes / 64.0;
+    out.parts.push_back(
+        {"dram", "DRAM accesses",
+         "activates x energy.dram_activate_pj + lines read x energy.dram_read_pj "
+         "+ lines written x energy.dram_write_pj (per 64 B of line)",
+         "",
+         events.dram_activates * pj(e.dram_activate_pj) +
+             (events.dram_reads * pj(e.dram_read_pj) + events.dram_writes * pj(e.dram_write_pj)) *
+                 lines_per_64,
+         0});
+    out.parts.push_back({"dram_background", "DRAM background (standby and refresh)",
+                         "channels x energy.dram_background_mw x chip/frame_seconds", "",
+                         chip.dram.channels * e.dram_background_mw * 1e-3 * out.seconds, 0});
+    return out;
+}
+
+RegisterAccesses register_accesses(std::span<const uint64_t> executed_per_op) {
+    RegisterAccesses out;
+    for (size_t op = 0; op < executed_per_op.size() && op < isa::kNumInsns; ++op) {
+        if (executed_per_op[op] == 0) continue;
+        const isa::InsnInfo& info = isa::info(isa::Op(op));
+        const isa::OperandInfo& o = info.operands;
+        const int reads = (o.rs1 != isa::RegKind::None) + (o.rs2 != isa::RegKind::None) +
+                          (info.format == isa::Format::R4);
+        out.reads += double(executed_per_op[op]) * reads;
+        out.writes += double(executed_per_op[op]) * (o.rd != isa::RegKind::None);
+    }
+    return out;
+}
+
+void register_stats(const timing::ChipConfig& chip, stats::Registry& registry) {
+    std::vector<std::string_view> inputs;
+    std::vector<std::string> names;
+    for (const stats::Entry& entry : registry.entries())
+        if (source_of(entry.name)) {
+            inputs.push_back(entry.name);
+            names.push_back(entry.name);
+        }
+    // Every statistic below recomputes the whole estimate from the same inputs: a few hundred
+    // additions, done when printed, never in the cycle loop.
+    const auto from = [chip, names](std::span<const double> values) {
+        return estimate(chip, events_from(names, values.first(names.size())));
+    };
+    const Estimate shape = estimate(chip, {});
+    for (size_t i = 0; i < shape.parts.size(); ++i)
+        registry.add_formula(
+            "energy/" + shape.parts[i].name, inputs,
+            [from, i](std::span<const double> v) { return from(v).parts[i].joules; },
+            fmt::format("energy of the {}: {}", shape.parts[i].what, shape.parts[i].energy_rule),
+            "J");
+    registry.add_formula(
+        "energy/total", inputs, [from](std::span<const double> v) { return from(v).joules(); },
+        "energy of the frame: the sum of energy/*", "J");
+    registry.add_formula(
+        "energy/average_watts", inputs,
+        [from](std::span<const double> v) { return from(v).watts(); },
+        "average power: energy/total / chip/frame_seconds", "W");
+    const auto per = [&](std::string name, std::string_view count, std::string description,
+                         std::string unit, bool per_joule) {
+        std::vector<std::string_view> with = inputs;
+        with.push_back(count);
+        registry.add_formula(
+            std::move(name), with,
+            [from, per_joule](std::span<const double> v) {
+                const double joules = from(v.first(v.size() - 1)).joules(), n = v.back();
+                if (per_joule) return joules > 0 ? n / joules / 1e6 : 0.0;
+                return n > 0 ? joules / n : 0.0;
+            },
+            std::move(description), std::move(unit));
+    };
+    if (registry.contains("image/pixels"))
+        per("energy/per_pixel", "image/pixels", "energy/total / image/pixels", "J", false);
+    if (registry.contains("rays/total")) {
+        per("energy/per_ray", "rays/total", "energy/total / rays/total", "J", false);
+        per("energy/mrays_per_joule", "rays/total", "rays/total / energy/total / 1e6", "Mrays/J",
+            true);
+    }
+    // Areas depend on the configuration only.
+    for (const Part& part : shape.parts)
+        if (!part.area_rule.empty())
+            registry.add_derived(
+                "area/" + part.name, [a = part.area_mm2] { return a; },
+                fmt::format("area of the {}: {}", part.what, part.area_rule), "mm^2");
+    registry.add_derived(
+        "area/total", [a = shape.area_mm2()] { return a; }, "chip area: the sum of area/*", "mm^2");
+}
+
+}  // namespace tpsim::energy
