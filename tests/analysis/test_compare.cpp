@@ -146,6 +146,37 @@ TEST_CASE("compare: region hit rates and per-ray figures are derived per run", "
     CHECK_FALSE(find_row(c, "region/camera/dram/writes"));
 }
 
+TEST_CASE("compare: the energy and area estimate has summary rows and sections by part",
+          "[analysis][energy]") {
+    const std::vector<StatsFile> runs = load({"base.json", "faster.json", "brute.json"});
+    const Comparison c = compare(runs);
+    for (const char* key : {"energy/total", "energy/average_watts", "energy/mrays_per_joule",
+                            "area/total", "energy/per_ray", "energy/dram", "area/l1"}) {
+        INFO(key);
+        const Row* row = find_row(c, key);
+        REQUIRE(row);
+        CHECK(row->values[0] == runs[0].stat(key));
+        CHECK(row->values[1] == runs[1].stat(key));
+        CHECK_FALSE(row->values[2]);  // brute.json predates the estimate: absent, not 0
+    }
+    CHECK(*find_row(c, "energy/total")->ratio(1) == Approx(0.0016 / 0.002));
+    CHECK(find_row(c, "energy/total")->better == Better::lower);
+    CHECK(find_row(c, "energy/mrays_per_joule")->better == Better::higher);
+    std::vector<std::string> energy_keys, area_keys;
+    for (const Section& s : c.sections) {
+        if (s.title == "energy by part")
+            for (const Row& row : s.rows)
+                energy_keys.push_back(row.key);
+        if (s.title == "area by part")
+            for (const Row& row : s.rows)
+                area_keys.push_back(row.key);
+    }
+    // The parts only: totals and rates are in the summary and per-ray sections.
+    CHECK(energy_keys == std::vector<std::string>{"energy/fu/fp_add", "energy/l1", "energy/dram",
+                                                  "energy/dram_background"});
+    CHECK(area_keys == std::vector<std::string>{"area/fu/fp_add", "area/l1"});
+}
+
 TEST_CASE("compare: --keys keeps only the matching rows and the sections that have any",
           "[analysis]") {
     const auto runs = load({"base.json", "brute.json"});

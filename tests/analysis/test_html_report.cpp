@@ -42,8 +42,24 @@ TEST_CASE("report: one page embeds images, Chart.js, charts and the configuratio
     CHECK(count(page, "src=\"data:image/png;base64,") == 2);
     CHECK(page.find("src=\"http") == std::string::npos);  // nothing fetched: opens offline
     const Json blob = blob_of(page);
-    // stalls, FU utilisation, traffic, 4 timeline charts (the hit rates share one)
-    CHECK(blob["charts"].size() == 7);
+    // stalls, FU utilisation, traffic, energy and area by part, 4 timeline charts (the hit
+    // rates share one)
+    CHECK(blob["charts"].size() == 9);
+    std::vector<std::string> titles;
+    for (const Json& chart : blob["charts"])
+        titles.push_back(chart["title"]);
+    CHECK(titles[3] == "Energy by part (share of the frame's energy)");
+    CHECK(titles[4] == "Area by part (share of the chip)");
+    // Shares of the fixture's energy/total (0.002 J) and area/total (1.576586 mm^2).
+    CHECK(blob["charts"][3]["labels"] ==
+          Json::array({"fu/fp_add", "l1", "dram", "dram_background"}));
+    CHECK(blob["charts"][3]["datasets"][0]["data"][2].get<double>() == Approx(60));  // dram
+    CHECK(blob["charts"][4]["datasets"][0]["data"][1].get<double>() ==
+          Approx(100 * 1.550098 / 1.576586));
+    CHECK(page.find("<div class=\"value\">2 mJ</div><div class=\"label\">energy per frame") !=
+          std::string::npos);
+    CHECK(page.find("<tr><td class=\"code\">l1</td><td class=\"num\">1.55</td>") !=
+          std::string::npos);  // the area table
     CHECK(count(page, "<canvas data-chart=") == blob["charts"].size());
     CHECK(page.find("<details><summary>Resolved chip configuration (7 keys)") != std::string::npos);
     CHECK(page.find("trax::rt::intersect_bvh(trax::rt::Ray const&amp;, trax::rt::Hit&amp;)") !=
@@ -67,7 +83,10 @@ TEST_CASE("report: the comparison page has grouped charts and the side-by-side t
     const Comparison c = compare(runs);
     const std::string page = comparison_page(runs, c, "");
     const Json charts = blob_of(page)["charts"];
-    REQUIRE(charts.size() == 5);
+    // summary, stalls, FU utilisation, per ray, energy and area by part, DRAM by region
+    REQUIRE(charts.size() == 7);
+    CHECK(charts[4]["title"] == "Energy by part (J)");
+    CHECK(charts[5]["title"] == "Area by part (mm²)");
     for (const Json& chart : charts)
         CHECK(chart["datasets"].size() == 3);  // one per run
     CHECK(count(page, "<img ") == 3);
