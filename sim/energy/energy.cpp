@@ -110,20 +110,15 @@ Estimate estimate(const timing::ChipConfig& chip, const Events& events) {
         tms * double((chip.chip.tps_per_tm + chip.icache.threads_per_icache - 1) /
                      chip.icache.threads_per_icache);
     // Every SRAM scales from the geometry its cited figure is for: the default chip's.
-    const auto sram = [](double cost, double size, double default_size, double banks,
-                         double default_banks, double size_exponent, double bank_exponent) {
-        return scale_sram(cost, size, default_size, banks, default_banks, size_exponent,
-                          bank_exponent);
-    };
     const auto energy_of = [&](double cost, double size, double default_size, double banks,
                                double default_banks) {
-        return sram(cost, size, default_size, banks, default_banks, e.sram_size_exponent,
-                    e.sram_bank_exponent);
+        return scale_sram(cost, size, default_size, banks, default_banks, e.sram_size_exponent,
+                          e.sram_bank_exponent);
     };
     const auto area_of = [&](double cost, double size, double default_size, double banks,
                              double default_banks) {
-        return sram(cost, size, default_size, banks, default_banks, a.sram_size_exponent,
-                    a.sram_bank_exponent);
+        return scale_sram(cost, size, default_size, banks, default_banks, a.sram_size_exponent,
+                          a.sram_bank_exponent);
     };
 
     Estimate out;
