@@ -211,13 +211,11 @@ RegisterAccesses register_accesses(std::span<const uint64_t> executed_per_op) {
 }
 
 void register_stats(const timing::ChipConfig& chip, stats::Registry& registry) {
-    std::vector<std::string_view> inputs;
+    // Copies of the names: registering grows the registry, which moves its entries' names.
     std::vector<std::string> names;
     for (const stats::Entry& entry : registry.entries())
-        if (source_of(entry.name)) {
-            inputs.push_back(entry.name);
-            names.push_back(entry.name);
-        }
+        if (source_of(entry.name)) names.push_back(entry.name);
+    const std::vector<std::string_view> inputs(names.begin(), names.end());
     // Every statistic below recomputes the whole estimate from the same inputs: a few hundred
     // additions, done when printed, never in the cycle loop.
     const auto from = [chip, names](std::span<const double> values) {
