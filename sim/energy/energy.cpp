@@ -90,11 +90,6 @@ double scale_sram(double cost, double size_bytes, double default_size_bytes, dou
            std::pow(banks / default_banks, bank_exponent);
 }
 
-double Estimate::joules() const {
-    return std::accumulate(parts.begin(), parts.end(), 0.0,
-                           [](double sum, const Part& p) { return sum + p.joules; });
-}
-
 double Estimate::area_mm2() const {
     return std::accumulate(parts.begin(), parts.end(), 0.0,
                            [](double sum, const Part& p) { return sum + p.area_mm2; });
@@ -215,45 +210,41 @@ void register_stats(const timing::ChipConfig& chip, stats::Registry& registry) {
     std::vector<std::string> names;
     for (const stats::Entry& entry : registry.entries())
         if (source_of(entry.name)) names.push_back(entry.name);
-    const std::vector<std::string_view> inputs(names.begin(), names.end());
-    // Every statistic below recomputes the whole estimate from the same inputs: a few hundred
-    // additions, done when printed, never in the cycle loop.
-    const auto from = [chip, names](std::span<const double> values) {
-        return estimate(chip, events_from(names, values.first(names.size())));
-    };
     const Estimate shape = estimate(chip, {});
-    for (size_t i = 0; i < shape.parts.size(); ++i)
+    std::vector<std::string> part_keys;
+    for (size_t i = 0; i < shape.parts.size(); ++i) {
+        // Each part is a formula over the statistics it depends on only, so that a sampled
+        // run's interval of one part is not made unknown by a rare event of another.
+        std::vector<std::string> used;
+        for (const std::string& name : names)
+            if (estimate(chip, events_from(std::span(&name, 1), std::array{1.0})).parts[i].joules !=
+                0)
+                used.push_back(name);
+        part_keys.push_back("energy/" + shape.parts[i].name);
         registry.add_formula(
-            "energy/" + shape.parts[i].name, inputs,
-            [from, i](std::span<const double> v) { return from(v).parts[i].joules; },
+            part_keys.back(), {used.begin(), used.end()},
+            [chip, used, i](std::span<const double> v) {
+                return estimate(chip, events_from(used, v)).parts[i].joules;
+            },
             fmt::format("energy of the {}: {}", shape.parts[i].what, shape.parts[i].energy_rule),
             "J");
+    }
     registry.add_formula(
-        "energy/total", inputs, [from](std::span<const double> v) { return from(v).joules(); },
-        "energy of the frame: the sum of energy/*", "J");
-    registry.add_formula(
-        "energy/average_watts", inputs,
-        [from](std::span<const double> v) { return from(v).watts(); },
-        "average power: energy/total / chip/frame_seconds", "W");
-    const auto per = [&](std::string name, std::string_view count, std::string description,
-                         std::string unit, bool per_joule) {
-        std::vector<std::string_view> with = inputs;
-        with.push_back(count);
-        registry.add_formula(
-            std::move(name), with,
-            [from, per_joule](std::span<const double> v) {
-                const double joules = from(v.first(v.size() - 1)).joules(), n = v.back();
-                if (per_joule) return joules > 0 ? n / joules / 1e6 : 0.0;
-                return n > 0 ? joules / n : 0.0;
-            },
-            std::move(description), std::move(unit));
-    };
+        "energy/total", {part_keys.begin(), part_keys.end()},
+        [](std::span<const double> v) { return std::accumulate(v.begin(), v.end(), 0.0); },
+        "energy of the frame: the sum of the energy/<part> keys", "J");
+    registry.add_ratio("energy/average_watts", "energy/total", "chip/frame_seconds",
+                       "average power: energy/total / chip/frame_seconds", "W");
     if (registry.contains("image/pixels"))
-        per("energy/per_pixel", "image/pixels", "energy/total / image/pixels", "J", false);
+        registry.add_ratio("energy/per_pixel", "energy/total", "image/pixels",
+                           "energy/total / image/pixels", "J");
     if (registry.contains("rays/total")) {
-        per("energy/per_ray", "rays/total", "energy/total / rays/total", "J", false);
-        per("energy/mrays_per_joule", "rays/total", "rays/total / energy/total / 1e6", "Mrays/J",
-            true);
+        registry.add_ratio("energy/per_ray", "energy/total", "rays/total",
+                           "energy/total / rays/total", "J");
+        registry.add_formula(
+            "energy/mrays_per_joule", {"rays/total", "energy/total"},
+            [](std::span<const double> v) { return v[1] > 0 ? v[0] / v[1] / 1e6 : 0.0; },
+            "rays/total / energy/total / 1e6", "Mrays/J");
     }
     // Areas depend on the configuration only.
     for (const Part& part : shape.parts)

@@ -54,13 +54,11 @@ struct Part {
     double area_mm2 = 0;
 };
 
-/// The estimate of one run: its parts in a fixed order, and their totals.
+/// The estimate of one run: its parts in a fixed order.
 struct Estimate {
     std::vector<Part> parts;
-    double seconds = 0;  ///< the frame time at chip.clock_mhz
-    double joules() const;
-    double area_mm2() const;
-    double watts() const { return seconds > 0 ? joules() / seconds : 0; }
+    double seconds = 0;       ///< the frame time at chip.clock_mhz
+    double area_mm2() const;  ///< the chip's: the sum of the parts'
 };
 
 /// The estimate for a run of `chip` that counted `events`.
@@ -81,9 +79,9 @@ struct RegisterAccesses {
 RegisterAccesses register_accesses(std::span<const uint64_t> executed_per_op);
 
 /// Registers energy/..., area/... and the derived rates (docs/statistics.md) as formulas over
-/// the registered counters, so that a sampled run's estimates carry through. Needs the chip's
-/// statistics and registers/reads, registers/writes registered; rays/total and image/pixels
-/// when present.
+/// the registered counters, so that a sampled run's estimates (and their intervals) carry
+/// through. Needs the chip's statistics and registers/reads, registers/writes registered;
+/// rays/total and image/pixels when present.
 void register_stats(const timing::ChipConfig& chip, stats::Registry& registry);
 
 }  // namespace tpsim::energy
