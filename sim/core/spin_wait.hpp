@@ -59,6 +59,19 @@ public:
         : spins_(spins_for(count)), completion_(std::move(completion)), count_(count) {}
 
     void arrive_and_wait() { arrive(false); }
+    /// Arrives as the one thread that always runs the completion, once all the others have
+    /// arrived: what the completion touches stays in that thread's core's caches.
+    void lead() {
+        const uint32_t phase = phase_.load(std::memory_order_acquire);
+        const uint32_t count = count_.load(std::memory_order_relaxed);
+        spin_until([&] { return arrived_.load(std::memory_order_acquire) + 1 == count; }, spins_);
+        completion_();
+        count_.store(count - dropping_.exchange(0, std::memory_order_relaxed),
+                     std::memory_order_relaxed);
+        arrived_.store(0, std::memory_order_relaxed);
+        phase_.store(phase + 1, std::memory_order_release);
+        phase_.notify_all();
+    }
     /// Arrives without waiting, and leaves: later phases wait for one thread fewer.
     void arrive_and_drop() { arrive(true); }
 

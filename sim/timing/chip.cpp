@@ -666,7 +666,10 @@ template <class Source> void Chip::run_windows_in_parallel(uint64_t end, Source&
     host.run([&](uint32_t lane) {
         while (more) {
             tick_lane(lane, lanes, first, window_end, source);
-            host.window_done.arrive_and_wait();
+            if (lane == 0)
+                host.window_done.lead();
+            else
+                host.window_done.arrive_and_wait();
         }
     });
     if (error) std::rethrow_exception(error);
