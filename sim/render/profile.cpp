@@ -41,6 +41,14 @@ bool has_costs(const ProfileCosts& c) {
     return c != ProfileCosts{};
 }
 
+/// The stall causes a profile shows: fetch_miss only with a finite I-cache (whose run always
+/// has some, its cold misses), so that without one the profile is what it always was.
+size_t shown_causes(const Profile& profile) {
+    constexpr size_t kFetchMiss = size_t(timing::Stall::FetchMiss);
+    static_assert(kFetchMiss + 1 == timing::kStallCauses, "fetch_miss is the last cause");
+    return profile.total.stalls[kFetchMiss] != 0 ? timing::kStallCauses : kFetchMiss;
+}
+
 }  // namespace
 
 Profile profile_of(const timing::PcProfile& words, const core::Program& program) {
@@ -93,11 +101,11 @@ Profile profile_of(const timing::PcProfile& words, const core::Program& program)
 
 namespace {
 
-void put_costs(nlohmann::ordered_json& entry, const ProfileCosts& c) {
+void put_costs(nlohmann::ordered_json& entry, const ProfileCosts& c, size_t causes) {
     entry["executions"] = c.executions;
     entry["cycles"] = c.cycles;
     nlohmann::ordered_json stalls = nlohmann::ordered_json::object();
-    for (size_t cause = 0; cause < kStallNames.size(); ++cause)
+    for (size_t cause = 0; cause < causes; ++cause)
         stalls[std::string(kStallNames[cause])] = c.stalls[cause];
     entry["stalls"] = std::move(stalls);
     entry["l1_misses"] = c.l1_misses;
@@ -107,16 +115,17 @@ void put_costs(nlohmann::ordered_json& entry, const ProfileCosts& c) {
 }  // namespace
 
 nlohmann::ordered_json profile_json(const Profile& profile) {
+    const size_t causes = shown_causes(profile);
     nlohmann::ordered_json functions = nlohmann::ordered_json::array();
     for (const FunctionProfile& f : profile.functions) {
         nlohmann::ordered_json entry{{"function", f.function}};
-        put_costs(entry, f.costs);
+        put_costs(entry, f.costs, causes);
         functions.push_back(std::move(entry));
     }
     nlohmann::ordered_json lines = nlohmann::ordered_json::array();
     for (const LineProfile& l : profile.lines) {
         nlohmann::ordered_json entry{{"file", l.file}, {"line", l.line}, {"function", l.function}};
-        put_costs(entry, l.costs);
+        put_costs(entry, l.costs, causes);
         lines.push_back(std::move(entry));
     }
     nlohmann::ordered_json json;
@@ -197,17 +206,18 @@ std::string fit(std::string text, size_t width) {
 
 constexpr size_t kTopFunctions = 10, kTopLines = 15, kNameWidth = 38;
 
+// With the fetch_miss column the names are 4 columns narrower: rows stay within 100 columns.
 void print_table_row(std::ostream& out, const ProfileCosts& c, uint64_t total,
-                     const std::string& name) {
+                     const std::string& name, size_t causes) {
     fmt::print(out, "{:5.1f}% {:>6} {:>6}", share(c.cycles, total), compact(c.cycles),
                compact(c.executions));
-    for (uint64_t stall : c.stalls)
-        if (stall == 0)
+    for (size_t cause = 0; cause < causes; ++cause)
+        if (const uint64_t stall = c.stalls[cause]; stall == 0)
             fmt::print(out, " {:>3}", "-");
         else
             fmt::print(out, " {:>2.0f}%", share(stall, c.cycles));
     fmt::print(out, " {:>6} {:>7}  {}\n", compact(c.l1_misses), compact_bytes(c.dram_bytes),
-               fit(name, kNameWidth));
+               fit(name, causes == timing::kStallCauses ? kNameWidth - 4 : kNameWidth));
 }
 
 /// The short name's last two scopes ("BvhTraversal::trace<false>"): beside a file:line the
@@ -224,33 +234,40 @@ std::string innermost_scopes(std::string_view function) {
     return name;
 }
 
-void print_table_head(std::ostream& out, const std::string& what) {
-    fmt::print(out, " share cycles  execs fet brn  fu mem opd syn L1miss    DRAM  {}\n", what);
+void print_table_head(std::ostream& out, const std::string& what, size_t causes) {
+    fmt::print(out, " share cycles  execs fet brn  fu mem opd syn{} L1miss    DRAM  {}\n",
+               causes == timing::kStallCauses ? " fmi" : "", what);
 }
 
 }  // namespace
 
 void print_profile(const Profile& p, std::ostream& out) {
     const uint64_t total = p.total.cycles;
+    const size_t causes = shown_causes(p);
     fmt::print(out,
                "profile  {} TP-cycles charged (issues + stalls), {} executions, {} L1 misses,\n"
                "         {} DRAM; stalls in % of the entry's cycles: fet fetch conflict,\n"
-               "         brn branch, fu FU busy, mem memory port, opd operand, syn sync\n",
-               total, p.total.executions, p.total.l1_misses, compact_bytes(p.total.dram_bytes));
+               "         brn branch, fu FU busy, mem memory port, opd operand, syn sync{}\n",
+               total, p.total.executions, p.total.l1_misses, compact_bytes(p.total.dram_bytes),
+               causes == timing::kStallCauses ? ",\n         fmi I-cache fetch miss" : "");
     print_table_head(out,
                      fmt::format("function (top {} of {})",
-                                 std::min(kTopFunctions, p.functions.size()), p.functions.size()));
+                                 std::min(kTopFunctions, p.functions.size()), p.functions.size()),
+                     causes);
     for (size_t i = 0; i < std::min(kTopFunctions, p.functions.size()); ++i)
         print_table_row(out, p.functions[i].costs, total,
-                        short_function_name(p.functions[i].function));
-    print_table_head(out, fmt::format("line (top {} of {})", std::min(kTopLines, p.lines.size()),
-                                      p.lines.size()));
+                        short_function_name(p.functions[i].function), causes);
+    print_table_head(
+        out,
+        fmt::format("line (top {} of {})", std::min(kTopLines, p.lines.size()), p.lines.size()),
+        causes);
     for (size_t i = 0; i < std::min(kTopLines, p.lines.size()); ++i) {
         const LineProfile& l = p.lines[i];
-        print_table_row(
-            out, l.costs, total,
-            l.path.empty() ? std::string(kUnknown)
-                           : fmt::format("{}:{} {}", l.file, l.line, innermost_scopes(l.function)));
+        print_table_row(out, l.costs, total,
+                        l.path.empty()
+                            ? std::string(kUnknown)
+                            : fmt::format("{}:{} {}", l.file, l.line, innermost_scopes(l.function)),
+                        causes);
     }
 }
 

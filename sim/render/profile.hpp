@@ -19,7 +19,7 @@ namespace tpsim::render {
 
 /// The stall causes in timing::Stall order, spelt as the statistics file spells them.
 inline constexpr std::array<std::string_view, timing::kStallCauses> kStallNames = {
-    "fetch_conflict", "branch", "fu_busy", "memory_port", "operand", "sync"};
+    "fetch_conflict", "branch", "fu_busy", "memory_port", "operand", "sync", "fetch_miss"};
 
 /// Where the profile puts addresses without a function or a source line.
 inline constexpr std::string_view kUnknown = "(unknown)";

@@ -50,6 +50,11 @@ std::string percent_text(double numerator, double denominator) {
     return denominator > 0 ? fmt::format("{:.1f}%", 100 * numerator / denominator) : "-";
 }
 
+bool has_value(const stats::Snapshot& snapshot, std::string_view name) {
+    return std::any_of(snapshot.values().begin(), snapshot.values().end(),
+                       [&](const stats::Value& v) { return v.name == name; });
+}
+
 }  // namespace
 
 std::string display_path(const std::filesystem::path& path) {
@@ -101,8 +106,20 @@ void print_traffic(const stats::Snapshot& snapshot, uint32_t line_bytes, std::os
             continue;
         }
         if (region == "instruction_fetch") {
-            fmt::print(out, "         {:<14} {:>12}  fetches (the I-cache never misses)\n",
-                       "instructions", count_text(get(region, "icache/fetches")));
+            const double fetches = get(region, "icache/fetches");
+            if (!has_value(snapshot, "region/instruction_fetch/l2/reads")) {
+                fmt::print(out, "         {:<14} {:>12}  fetches (the I-cache never misses)\n",
+                           "instructions", count_text(fetches));
+                continue;
+            }
+            // A finite I-cache: its hits, and its line requests to the L2 and DRAM.
+            const double waited =
+                snapshot.value("chip/icache/misses") + snapshot.value("chip/icache/merged_misses");
+            const double l2_reads = get(region, "l2/reads");
+            fmt::print(out, "         {:<14} {:>12} {:>7} {:>10} {:>7} {:>11}  (I-cache fetches)\n",
+                       "instructions", count_text(fetches), percent_text(fetches - waited, fetches),
+                       count_text(l2_reads), percent_text(get(region, "l2/hits"), l2_reads),
+                       bytes_text(get(region, "dram/reads") * line_bytes));
             continue;
         }
         const double l1_reads = get(region, "l1/reads"), l1_writes = get(region, "l1/writes");
@@ -381,6 +398,18 @@ void print_summary(const RenderOptions& options, const RenderResult& r,
                    get("energy/average_watts"), options.chip.chip.clock_mhz,
                    rays ? fmt::format(", {:.1f} M rays/J", get("energy/mrays_per_joule")) : "");
         fmt::print(out, "area     {:.2f} mm^2 (65 nm)\n", get("area/total"));
+    }
+    if (r.timing && has_value(statistics.values, "chip/icache/misses")) {
+        const stats::Snapshot& v = statistics.values;
+        fmt::print(
+            out,
+            "icache   {} misses and {} merged misses in {} fetches ({:.2f} % waited for a "
+            "line), {} TP-cycles of fetch-miss stalls ({} of active TP-cycles)\n",
+            count_text(v.value("chip/icache/misses")),
+            count_text(v.value("chip/icache/merged_misses")),
+            count_text(v.value("chip/icache/fetches")), 100 * v.value("chip/icache/miss_rate"),
+            count_text(v.value("chip/stalls/fetch_miss")),
+            percent_text(v.value("chip/stalls/fetch_miss"), v.value("chip/active_tp_cycles")));
     }
     if (r.instructions.total > 0)
         fmt::print(out,

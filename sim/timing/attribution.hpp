@@ -17,6 +17,7 @@ enum class Stall : uint8_t {
     MemoryPort,     ///< a previous load/store still waits for an L1 bank or MSHR
     Operand,        ///< an operand is not ready; attributed to its producing pool
     Sync,           ///< waiting at the barrier or for a semaphore (tp.barrier, tp.semacq ...)
+    FetchMiss,      ///< waiting for an instruction line from the L2 (finite I-cache only)
     Count
 };
 constexpr size_t kStallCauses = static_cast<size_t>(Stall::Count);

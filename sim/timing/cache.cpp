@@ -48,29 +48,33 @@ CacheOutcome Cache::access(uint64_t now, const MemRequest& request) {
         ++counters_.bank_conflicts;
         return CacheOutcome::BankConflict;
     }
-    const uint32_t line = line_of(request.addr);
-    const uint64_t after_lookup = now + config_.hit_latency;
-
     if (request.write) {
         bank_used = now;
         ++counters_.writes;
-        if (Way* way = find(line)) way->last_use = ++use_clock_;
+        if (Way* way = find(line_of(request.addr))) way->last_use = ++use_clock_;
+        const uint64_t after_lookup = now + config_.hit_latency;
         if (combining_capacity_ != 0) return combine(after_lookup, request);
         outbound_.push_back({after_lookup, request});
         return CacheOutcome::WriteForward;
     }
+    const CacheOutcome outcome = read(now, request, true);
+    if (outcome != CacheOutcome::MshrFull) bank_used = now;
+    return outcome;
+}
+
+CacheOutcome Cache::read(uint64_t now, const MemRequest& request, bool reply_on_hit) {
+    const uint32_t line = line_of(request.addr);
+    const uint64_t after_lookup = now + config_.hit_latency;
     if (Way* way = find(line)) {
-        bank_used = now;
         ++counters_.reads;
         ++counters_.hits;
         way->last_use = ++use_clock_;
-        replies_.push_back({after_lookup, request});
+        if (reply_on_hit) replies_.push_back({after_lookup, request});
         return CacheOutcome::Hit;
     }
     Mshr* free_mshr = nullptr;
     for (Mshr& m : mshrs_) {
         if (m.busy && m.line == line) {
-            bank_used = now;
             ++counters_.reads;
             ++counters_.merged_misses;
             m.waiters.push_back(request);
@@ -82,7 +86,6 @@ CacheOutcome Cache::access(uint64_t now, const MemRequest& request) {
         ++counters_.mshr_full;
         return CacheOutcome::MshrFull;
     }
-    bank_used = now;
     ++counters_.reads;
     ++counters_.misses;
     // The line's buffered stores reach the next level before the line is read from it.
@@ -190,20 +193,6 @@ void Cache::register_stats(stats::Registry& r, std::string_view prefix) const {
                   "accesses");
     r.add_counter(name("evictions"), counters_.evictions, "valid lines replaced", "lines");
     r.add_ratio(name("hit_rate"), name("hits"), name("reads"), "hits / reads");
-}
-
-ICacheBanks::ICacheBanks(const ICacheConfig& config, uint32_t num_threads)
-    : bank_mod_(config.banks),
-      banks_(size_t{(num_threads + config.threads_per_icache - 1) / config.threads_per_icache} *
-             config.banks) {
-    for (uint32_t tp = 0; tp < num_threads; ++tp)
-        first_bank_.push_back(tp / config.threads_per_icache * config.banks);
-}
-
-void ICacheBanks::register_stats(stats::Registry& r, std::string_view prefix) const {
-    r.add_counter(fmt::format("{}/fetches", prefix), counters_.fetches, "instructions fetched");
-    r.add_counter(fmt::format("{}/conflicts", prefix), counters_.conflicts,
-                  "fetches refused by an I-cache bank conflict (one cycle lost each)");
 }
 
 }  // namespace tpsim::timing

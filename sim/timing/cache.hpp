@@ -22,7 +22,7 @@
 namespace tpsim::timing {
 
 /// n % divisor without a division when the divisor is a power of two (the usual bank and set
-/// counts): the caches take several per access, the I-cache one per fetch.
+/// counts): the caches take several per access, the I-cache banks one per fetch.
 class Modulus {
 public:
     explicit Modulus(uint32_t divisor)
@@ -67,6 +67,12 @@ public:
 
     /// Presents one access in cycle `now`; calls must come in non-decreasing `now`.
     CacheOutcome access(uint64_t now, const MemRequest& request);
+    /// An instruction fetch (a finite I-cache's tags, ICacheLines): the caller has arbitrated
+    /// the banks, and a hit queues no reply (the fetch goes on in this cycle); a miss is a
+    /// load's miss.
+    CacheOutcome fetch(uint64_t now, const MemRequest& request) {
+        return read(now, request, false);
+    }
     /// The line holding `line_addr` arrives from the next level in cycle `now`: it is
     /// installed (evicting the LRU way) and every merged waiter gets a reply at now + hit_latency.
     void fill(uint64_t now, uint32_t line_addr);
@@ -119,6 +125,8 @@ private:
     };
 
     Way* find(uint32_t line);
+    /// A load whose bank is free: a hit (with a reply if `reply_on_hit`), a miss or a merge.
+    CacheOutcome read(uint64_t now, const MemRequest& request, bool reply_on_hit);
     /// Puts `line` (not present) into the LRU way of its set; returns whether it evicted one.
     bool install(uint32_t line);
     CacheOutcome combine(uint64_t now, const MemRequest& request);
@@ -140,59 +148,6 @@ private:
     std::deque<OutboundRequest> outbound_;
     uint32_t combining_capacity_;
     std::vector<CombiningLine> combining_;  // oldest first
-    Counters counters_;
-};
-
-/// Instruction fetch banks: TRaX's I-cache never misses, so only bank conflicts are modelled.
-/// Threads sharing one I-cache fetch from banks interleaved by instruction word; each bank
-/// serves one address per cycle, and threads fetching the same address share it (broadcast).
-class ICacheBanks {
-public:
-    struct Counters {
-        uint64_t fetches = 0;    ///< granted fetches
-        uint64_t conflicts = 0;  ///< refused fetches (bank busy with another address)
-    };
-
-    ICacheBanks(const ICacheConfig& config, uint32_t num_threads);
-
-    /// Threads tp_of(b), for each set bit b of `wanting`, fetch pc_of(thread) in cycle `now`,
-    /// lowest bit first: within a cycle earlier fetches win, so the caller decides the
-    /// (rotating) order. Returns the granted bits; the others conflict and try again next cycle.
-    template <class TpOf, class PcOf>
-    [[gnu::always_inline]] uint64_t fetch(uint64_t now, uint64_t wanting, TpOf&& tp_of,
-                                          PcOf&& pc_of) {
-        // Once per simulated instruction: no division (the thread's first bank is precomputed,
-        // a power-of-two bank count is a mask), and no branch on whether a fetch conflicts,
-        // which is unpredictable for the host.
-        const uint32_t* first_bank = first_bank_.data();
-        Bank* banks = banks_.data();
-        uint64_t granted = 0;
-        for (uint64_t bits = wanting; bits != 0; bits &= bits - 1) {
-            const uint32_t bit = static_cast<uint32_t>(std::countr_zero(bits));
-            const uint32_t tp = tp_of(bit);
-            const uint32_t pc = pc_of(tp);
-            Bank& bank = banks[first_bank[tp] + bank_mod_.of(pc / 4)];
-            const bool ok = (bank.cycle != now) | (bank.pc == pc);
-            bank.cycle = now;
-            bank.pc ^= (bank.pc ^ pc) & -uint32_t{ok};
-            granted |= uint64_t{ok} << bit;
-        }
-        counters_.fetches += count_bits(granted);
-        counters_.conflicts += count_bits(wanting & ~granted);
-        return granted;
-    }
-
-    const Counters& counters() const { return counters_; }
-    void register_stats(stats::Registry& registry, std::string_view prefix) const;
-
-private:
-    struct Bank {
-        uint64_t cycle = UINT64_MAX;  // cycle of the current reservation
-        uint32_t pc = 0;
-    };
-    Modulus bank_mod_;                  // banks per I-cache
-    std::vector<uint32_t> first_bank_;  // per thread: index of its I-cache's bank 0
-    std::vector<Bank> banks_;           // all I-caches of the TM, banks_per_icache_ each
     Counters counters_;
 };
 

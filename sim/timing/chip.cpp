@@ -25,6 +25,9 @@ constexpr uint64_t kNever = UINT64_MAX;
 /// wake_at of a TP waiting at the barrier or for a semaphore: only the global-register unit's
 /// reply wakes it (Tm::wake_from_sync), not the replies wake() serves.
 constexpr uint64_t kSyncWait = kNever - 1;
+/// wake_at of a TP waiting for an instruction line (a finite I-cache's miss): only the I-cache's
+/// reply wakes it (Tm::wake_from_fetch).
+constexpr uint64_t kFetchWait = kNever - 2;
 constexpr uint64_t kDeadlockCycles = 1'000'000;
 constexpr size_t kPools = static_cast<size_t>(Pool::Count);
 constexpr size_t kStalls = static_cast<size_t>(Stall::Count);
@@ -102,8 +105,12 @@ struct alignas(64) Chip::Tm {
 
     Tm(const ChipConfig& c, uint32_t id, size_t regions)
         : id(id), words((c.chip.tps_per_tm + 63) / 64), tps(c.chip.tps_per_tm),
-          icache(c.icache, c.chip.tps_per_tm), l1(c.l1), awake_tps(words), pending_tps(words),
-          needs_port_tps(words), mem_waiting_tps(words), issuing_tps(words), asking_tps(words),
+          icache(c.icache, c.chip.tps_per_tm),
+          lines(c.icache.finite()
+                    ? std::make_unique<ICacheLines>(c.icache, c.chip.tps_per_tm, uint8_t(regions))
+                    : nullptr),
+          l1(c.l1), awake_tps(words), pending_tps(words), needs_port_tps(words),
+          mem_waiting_tps(words), issuing_tps(words), asking_tps(words),
           wheel_slots(std::min(std::bit_ceil(longest_timed_sleep(c) + 1), kMaxWheelSlots)),
           sleeps_outlast_wheel(longest_timed_sleep(c) >= wheel_slots), wheel(wheel_slots * words),
           l1_traffic(regions) {
@@ -142,10 +149,27 @@ struct alignas(64) Chip::Tm {
                 pc->stalls[size_t(Stall::Sync)] += waited;
         tp.wake_at = now;
     }
-    /// Start of cycle `now`: L2 fills, global-register replies, then the L1's replies.
+    /// A finite I-cache's reply: the line TP i missed on has arrived (forwarded to it), so it
+    /// fetches again, with fetch-miss stall cycles from the cycle of its miss.
+    void wake_from_fetch(uint32_t i, uint32_t pc, uint64_t now) {
+        Tp& tp = tps[i];
+        set_bit(awake_tps, i);
+        const uint64_t waited = now - tp.asleep_from;
+        counters.active_tp_cycles += waited;
+        counters.stalls[size_t(Stall::FetchMiss)] += waited;
+        if (profile)
+            if (PcCounters* counters_at = profile->at(pc))
+                counters_at->stalls[size_t(Stall::FetchMiss)] += waited;
+        tp.wake_at = now;
+    }
+    /// Start of cycle `now`: L2 fills, global-register replies, then the L1's and the finite
+    /// I-cache's replies.
     void receive(uint64_t now) {
         for (; !fills.empty() && fills.front().cycle <= now; fills.pop_front())
-            l1.fill(now, fills.front().line);
+            if (fills.front().icache == kDataLine) [[likely]]
+                l1.fill(now, fills.front().line);
+            else
+                lines->fill(now, fills.front().icache, fills.front().line);
         for (; !replies.empty() && replies.front().ready <= now; replies.pop_front()) {
             const AtomicRequest& atomic = replies.front().request;
             if (atomic.kind == GlobalRequest::Increment) [[likely]] {
@@ -162,6 +186,11 @@ struct alignas(64) Chip::Tm {
             wake(reply.request.source, now);
             ++progress;
         }
+        if (lines) [[unlikely]]
+            while (lines->pop_reply(now, reply)) {
+                wake_from_fetch(reply.request.source, reply.request.pc, now);
+                ++progress;
+            }
     }
     /// TP i leaves the awake set until cycle `at` (> now), when the wheel puts it back. A
     /// sleep longer than the wheel (configs with huge latencies) waits in the wheel's last slot
@@ -195,6 +224,7 @@ struct alignas(64) Chip::Tm {
     std::vector<Tp> tps;
     std::vector<FuPool> pools;
     ICacheBanks icache;
+    std::unique_ptr<ICacheLines> lines;  // a finite I-cache's contents; none: it never misses
     Cache l1;
     uint32_t rotation = 0;  // TP that goes first this cycle (fetch and L1 priority)
     uint32_t atomic_sequence = 0;
@@ -204,11 +234,13 @@ struct alignas(64) Chip::Tm {
     uint32_t running = 0;
     uint64_t idle_from = kNever;  // first cycle with every thread exited
     // Delivered before each window (Chip::deliver), received in the cycle they arrive: L2
-    // fills of L1 lines and global-register replies, each in the order the shared parts
-    // produced them.
+    // fills of L1 (or I-cache) lines and global-register replies, each in the order the shared
+    // parts produced them.
+    static constexpr uint32_t kDataLine = UINT32_MAX;
     struct Fill {
         uint64_t cycle;
         uint32_t line;
+        uint32_t icache;  // the I-cache in the TM the line is for, or kDataLine (the L1)
     };
     std::deque<Fill> fills;
     std::deque<AtomicReply> replies;
@@ -273,6 +305,7 @@ Chip::Chip(const ChipConfig& config, InstructionSource& source, const ChipLayout
                             layout.regions[region_bounds_[r - 1].index].name,
                             layout.regions[region_bounds_[r].index].name));
     other_region_ = uint8_t(layout.regions.size());
+    fetch_region_ = uint8_t(other_region_ + 1);
     work_items_.items.resize(layout.work_items);
     if (layout.profile) {
         profile_.text = layout.text;
@@ -281,8 +314,8 @@ Chip::Chip(const ChipConfig& config, InstructionSource& source, const ChipLayout
     }
     const size_t regions = layout.regions.size() + 1;
     l1_traffic_.resize(regions);
-    l2_traffic_.resize(regions);
-    dram_traffic_.resize(regions);
+    l2_traffic_.resize(regions + 1);  // and fetch_region_
+    dram_traffic_.resize(regions + 1);
 
     for (size_t fu = 0; fu < pool_of_.size(); ++fu)
         pool_of_[fu] = pool_of(isa::FuClass(fu));
@@ -398,9 +431,10 @@ bool Chip::quiescent() const {
     for (const auto& tm : tms_) {
         for (uint32_t w = 0; w < tm->words; ++w)
             if (tm->pending_tps[w] | tm->mem_waiting_tps[w]) return false;
-        // A TP asleep until a reply still has a load or an atomic in flight.
+        // A TP asleep until a reply still has a load, an atomic or an instruction line in
+        // flight.
         for (const Tm::Tp& tp : tm->tps)
-            if (tp.wake_at == kNever) return false;
+            if (tp.wake_at == kNever || tp.wake_at == kFetchWait) return false;
         if (tm->l1.outstanding_misses() || !tm->l1.outbound().empty() || !tm->atomics_out.empty() ||
             !tm->replies.empty())
             return false;
@@ -728,7 +762,9 @@ void Chip::deliver(uint64_t end) {
     MemReply reply;
     for (Cache& l2 : l2s_)
         while (l2.pop_reply(end - 1, reply))
-            tms_[reply.request.source]->fills.push_back({reply.ready, reply.request.addr});
+            tms_[reply.request.source]->fills.push_back(
+                {reply.ready, reply.request.addr,
+                 reply.request.region == fetch_region_ ? reply.request.tag : Tm::kDataLine});
     AtomicReply atomic;
     while (global_registers_.pop_reply(end - 1, atomic))
         tms_[atomic.request.tm]->replies.push_back(atomic);
@@ -924,15 +960,17 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
     const auto fetch_part = [&](const RotatedPart& part) __attribute__((always_inline)) {
         const uint32_t w = part.w;
         const uint64_t fetching = part.of(tm.awake_tps[w] & ~tm.pending_tps[w]);
-        const uint64_t fetched = tm.icache.fetch(
+        const uint64_t granted = tm.icache.fetch(
             now, fetching, [&](uint32_t bit) { return part.index(bit); },
             [&](uint32_t i) { return source.next_pc(first_thread + i); });
-        counters.stalls[size_t(Stall::FetchConflict)] += count_bits(fetching & ~fetched);
+        counters.stalls[size_t(Stall::FetchConflict)] += count_bits(fetching & ~granted);
         if constexpr (kProfile)
-            for (uint64_t bits = fetching & ~fetched; bits != 0; bits &= bits - 1) {
+            for (uint64_t bits = fetching & ~granted; bits != 0; bits &= bits - 1) {
                 const uint32_t thread = first_thread + part.index(uint32_t(std::countr_zero(bits)));
                 ++profile_at(source.next_pc(thread)).stalls[size_t(Stall::FetchConflict)];
             }
+        const uint64_t fetched =
+            tm.lines ? fetch_lines<Source, kProfile>(tm, part, granted, now, source) : granted;
         uint64_t needs_port = 0;
         for (uint64_t bits = fetched; bits != 0; bits &= bits - 1) {
             const auto bit = static_cast<uint32_t>(std::countr_zero(bits));
@@ -1104,23 +1142,60 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
     tm.rotation = tm.rotation + 1 == n ? 0 : tm.rotation + 1;
 }
 
+template <class Source, bool kProfile>
+uint64_t Chip::fetch_lines(Tm& tm, const RotatedPart& part, uint64_t granted, uint64_t now,
+                           Source& source) {
+    const uint32_t first_thread = tm.id * config_.chip.tps_per_tm;
+    uint64_t hits = 0;
+    for (uint64_t bits = granted; bits != 0; bits &= bits - 1) {
+        const auto bit = static_cast<uint32_t>(std::countr_zero(bits));
+        const uint32_t i = part.index(bit);
+        Tm::Tp& tp = tm.tps[i];
+        const uint32_t pc = source.next_pc(first_thread + i);
+        switch (tm.lines->fetch(now, i, pc, tp.item)) {
+        case CacheOutcome::Hit:
+            hits |= uint64_t{1} << bit;
+            break;
+        case CacheOutcome::MshrFull:  // stays awake and tries again next cycle
+            ++tm.counters.stalls[size_t(Stall::FetchMiss)];
+            if constexpr (kProfile) {
+                PcCounters* counters = tm.profile->at(pc);
+                ++(counters ? *counters : *tm.outside_text).stalls[size_t(Stall::FetchMiss)];
+            }
+            break;
+        default:  // Miss or MergedMiss: asleep from this cycle until the line arrives
+            clear_bit(tm.awake_tps, i);
+            tp.wake_at = kFetchWait;
+            tp.asleep_from = now;
+            break;
+        }
+    }
+    tm.lines->send(tm.l1.outbound());
+    return hits;
+}
+
 namespace {
 
-constexpr std::string_view kStallNames[] = {"fetch_conflict", "branch",  "fu_busy",
-                                            "memory_port",    "operand", "sync"};
+constexpr std::string_view kStallNames[] = {"fetch_conflict", "branch", "fu_busy",   "memory_port",
+                                            "operand",        "sync",   "fetch_miss"};
 static_assert(std::size(kStallNames) == kStalls);
 
 }  // namespace
 
 void Chip::register_stats(stats::Registry& r) const {
     const double threads = double(config_.chip.num_tms) * config_.chip.tps_per_tm;
+    // A finite I-cache's keys exist only with one: with an I-cache that never misses, the
+    // statistics are what they were before there was a choice.
+    const bool finite_icache = config_.icache.finite();
+    const size_t stall_causes = finite_icache ? kStalls : size_t(Stall::FetchMiss);
+    const std::span<const std::string_view> stall_names(kStallNames, stall_causes);
     for (const auto& tm_ptr : tms_) {
         const Tm& tm = *tm_ptr;
         const std::string p = fmt::format("tm{}", tm.id);
         r.add_counter(p + "/instructions", tm.counters.instructions, "instructions issued");
         r.add_counter(p + "/active_tp_cycles", tm.counters.active_tp_cycles,
                       "TP-cycles of threads that had not exited (= issued + stalled)", "TP-cycles");
-        for (size_t s = 0; s < kStalls; ++s)
+        for (size_t s = 0; s < stall_causes; ++s)
             r.add_counter(fmt::format("{}/stalls/{}", p, kStallNames[s]), tm.counters.stalls[s],
                           "TP-cycles without issue, by cause (docs/statistics.md)", "TP-cycles");
         for (size_t q = 0; q < kPools; ++q)
@@ -1133,6 +1208,7 @@ void Chip::register_stats(stats::Registry& r) const {
         for (size_t q = 0; q < kPools; ++q)
             tm.pools[q].register_stats(r, fmt::format("{}/fu/{}", p, to_string(Pool(q))));
         tm.icache.register_stats(r, p + "/icache");
+        if (tm.lines) tm.lines->register_stats(r, p + "/icache");
         tm.l1.register_stats(r, p + "/l1");
         r.add_counter(p + "/local_store/loads", tm.counters.local_loads, "local-store loads");
         r.add_counter(p + "/local_store/stores", tm.counters.local_stores, "local-store stores");
@@ -1159,7 +1235,7 @@ void Chip::register_stats(stats::Registry& r) const {
         "instructions per thread per cycle (1 = every TP issues every cycle)");
     r.add_sum("chip/active_tp_cycles", "*/active_tp_cycles", "TP-cycles before exit, all TMs",
               "TP-cycles");
-    for (std::string_view stall : kStallNames)
+    for (std::string_view stall : stall_names)
         r.add_sum(fmt::format("chip/stalls/{}", stall), fmt::format("*/stalls/{}", stall),
                   "TP-cycles without issue by cause, all TMs", "TP-cycles");
     for (size_t q = 0; q < kPools; ++q) {
@@ -1239,6 +1315,37 @@ void Chip::register_stats(stats::Registry& r) const {
                   "bytes of those loads and stores", "B");
     r.add_sum("region/instruction_fetch/icache/fetches", "*/icache/fetches",
               "instructions fetched, all TMs", "instructions");
+    if (!finite_icache) return;
+    // After the region's sum of */icache/fetches, which chip/icache/fetches would join.
+    const auto add_fetch_traffic = [&](std::string_view level, const LevelTraffic& t, bool cache) {
+        const std::string p = fmt::format("region/instruction_fetch/{}/", level);
+        r.add_counter(p + "reads", t.reads,
+                      cache ? "I-cache line requests accepted" : "line reads served", "accesses");
+        if (cache) {
+            r.add_counter(p + "hits", t.hits, "line requests that hit", "accesses");
+            r.add_counter(p + "misses", t.misses, "line requests that requested a line below",
+                          "accesses");
+            r.add_counter(p + "merged_misses", t.merged_misses,
+                          "line requests merged into an outstanding miss", "accesses");
+        }
+        r.add_counter(p + "payload_bytes", t.payload_bytes,
+                      "bytes of instruction lines asked of this level", "B");
+        r.add_counter(p + "moved_bytes", t.moved_bytes,
+                      "bytes this level moved to or from the level below", "B");
+    };
+    add_fetch_traffic("l2", l2_traffic_[fetch_region_], true);
+    add_fetch_traffic("dram", dram_traffic_[fetch_region_], false);
+    r.add_sum("chip/icache/fetches", "*/icache/fetches", "instructions fetched, all TMs",
+              "instructions");
+    for (std::string_view leaf : {"misses", "merged_misses", "mshr_full", "evictions"})
+        r.add_sum(fmt::format("chip/icache/{}", leaf), fmt::format("*/icache/{}", leaf),
+                  fmt::format("I-cache {}, all TMs", leaf),
+                  leaf == "evictions" ? "lines" : "fetches");
+    r.add_formula(
+        "chip/icache/miss_rate",
+        {"chip/icache/misses", "chip/icache/merged_misses", "chip/icache/fetches"},
+        [](Values v) { return v[2] ? (v[0] + v[1]) / v[2] : 0.0; },
+        "(misses + merged_misses) / fetches: the fetched instructions that waited for a line");
 }
 
 }  // namespace tpsim::timing

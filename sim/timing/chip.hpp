@@ -26,6 +26,7 @@
 #include "sim/timing/dram.hpp"
 #include "sim/timing/fu_pool.hpp"
 #include "sim/timing/global_registers.hpp"
+#include "sim/timing/icache.hpp"
 
 #include <array>
 #include <cstdint>
@@ -179,6 +180,11 @@ private:
     /// unit, and the TP sleeps until the reply. Cold: out of the issue loop.
     [[gnu::cold, gnu::noinline]] void send_sync(Tm& tm, uint32_t i, const StepInfo& s,
                                                 uint64_t now);
+    /// A finite I-cache's lookups of the fetches in `granted` (bits of `part`, their banks
+    /// granted): returns the hits; a TP that missed waits for its line (Tm::wake_from_fetch).
+    template <class Source, bool kProfile>
+    [[gnu::noinline]] uint64_t fetch_lines(Tm& tm, const RotatedPart& part, uint64_t granted,
+                                           uint64_t now, Source& source);
     // kWords: words per TP bit set, 0 = any; kProfile: collect the PcProfile.
     template <class Source, uint32_t kWords, bool kProfile>
     void tick_tm(Tm& tm, uint64_t now, Source& source);
@@ -221,7 +227,9 @@ private:
     };
     std::vector<RegionBounds> region_bounds_;
     uint8_t other_region_ = 0;  // index of "other": layout_.regions.size()
+    uint8_t fetch_region_ = 0;  // of a finite I-cache's line requests: other_region_ + 1
     // Traffic by region (index as MemRequest::region); l1_traffic_ sums the TMs' in collect().
+    // The L2 and DRAM also count fetch_region_'s.
     std::vector<LevelTraffic> l1_traffic_, l2_traffic_, dram_traffic_;
     uint64_t local_payload_bytes_ = 0;  // summed in collect()
     WorkItemCosts work_items_;

@@ -54,6 +54,10 @@ template <class Config, class Visit> void for_each_field(Config& c, Visit&& visi
     pool("atomic", c.fu.atomic);
     visit("icache.threads_per_icache", c.icache.threads_per_icache, Range{1, 1024});
     visit("icache.banks", c.icache.banks, Range{1, 1024});
+    visit("icache.size_bytes", c.icache.size_bytes, Range{0, 1u << 30});
+    visit("icache.ways", c.icache.ways, Range{1, 64});
+    visit("icache.line_bytes", c.icache.line_bytes, Range{4, 4096});
+    visit("icache.mshrs", c.icache.mshrs, Range{1, 4096});
     auto cache = [&](std::string_view name, auto& cc) {
         visit(fmt::format("{}.size_bytes", name), cc.size_bytes, Range{64, 1u << 30});
         visit(fmt::format("{}.ways", name), cc.ways, Range{1, 64});
@@ -242,6 +246,13 @@ void validate(const ChipConfig& config) {
     });
     validate_cache(config.l1, "l1");
     validate_cache(config.l2, "l2");
+    if (config.icache.finite()) {
+        validate_cache(icache_lines_config(config.icache), "icache");
+        check(config.icache.line_bytes == config.l1.line_bytes,
+              fmt::format("icache.line_bytes = {} must equal l1.line_bytes = {} (one line size "
+                          "throughout the hierarchy)",
+                          config.icache.line_bytes, config.l1.line_bytes));
+    }
     check(config.l1.line_bytes == config.l2.line_bytes,
           fmt::format("l2.line_bytes = {} must equal l1.line_bytes = {} (one line size "
                       "throughout the hierarchy)",
@@ -279,6 +290,9 @@ std::vector<HostBytes> host_bytes(const ChipConfig& config) {
          "the L1 caches' tag and state arrays", "l1.size_bytes (or chip.num_tms)"},
         {uint64_t{config.num_l2()} * (config.l2.size_bytes / config.l2.line_bytes) * kPerLine,
          "the L2 caches' tag and state arrays", "l2.size_bytes (or chip.tms_per_l2)"},
+        {uint64_t{config.chip.num_tms} * config.icaches_per_tm() *
+             (config.icache.size_bytes / config.icache.line_bytes) * kPerLine,
+         "the I-caches' tag and state arrays", "icache.size_bytes (or chip.num_tms)"},
         {threads * config.tp.local_store_bytes, "the threads' local stores",
          "tp.local_store_bytes (or chip.num_tms, chip.tps_per_tm)"},
         {threads * kPerThread, "the threads' machine and pipeline state",

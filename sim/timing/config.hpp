@@ -59,11 +59,18 @@ struct FuPoolsConfig {
     bool operator==(const FuPoolsConfig&) const = default;
 };
 
-/// [icache] Instruction fetch. The I-cache never misses (as in TRaX); only bank conflicts
-/// between threads fetching in the same cycle are modelled.
+/// [icache] Instruction fetch. Bank conflicts between threads fetching in the same cycle are
+/// always modelled. By default (size_bytes = 0) the I-cache never misses, as in TRaX; a finite
+/// I-cache (size_bytes > 0) misses, and its misses are line requests to the L2
+/// (docs/hardware-model.md).
 struct ICacheConfig {
     uint32_t threads_per_icache = 16;  ///< TPs sharing one instruction cache
     uint32_t banks = 16;               ///< banks per instruction cache, interleaved by word
+    uint32_t size_bytes = 0;           ///< capacity of each I-cache; 0: it never misses (TRaX)
+    uint32_t ways = 4;                 ///< associativity (LRU) of a finite I-cache
+    uint32_t line_bytes = 64;          ///< line size; equals l1.line_bytes (one line size)
+    uint32_t mshrs = 8;                ///< outstanding missed lines per I-cache
+    bool finite() const { return size_bytes != 0; }
     bool operator==(const ICacheConfig&) const = default;
 };
 
@@ -77,6 +84,12 @@ struct CacheConfig {
     uint32_t mshrs = 16;          ///< outstanding missed lines; misses to one line merge
     bool operator==(const CacheConfig&) const = default;
 };
+
+/// A finite I-cache's tags as a Cache: its size, ways, line and MSHRs; one bank (ICacheBanks
+/// arbitrates the fetch banks) and a lookup of one cycle, after which a miss leaves for the L2.
+inline CacheConfig icache_lines_config(const ICacheConfig& c) {
+    return {c.size_bytes, c.ways, c.line_bytes, 1, 1, c.mshrs};
+}
 
 /// [l2] The L2 adds a store policy to the cache above (docs/hardware-model.md).
 struct L2Config : CacheConfig {
@@ -215,6 +228,10 @@ struct ChipConfig {
 
     /// Number of L2 caches: one per group of chip.tms_per_l2 TMs.
     uint32_t num_l2() const { return (chip.num_tms + chip.tms_per_l2 - 1) / chip.tms_per_l2; }
+    /// I-caches per TM: one per icache.threads_per_icache TPs; the last may serve fewer.
+    uint32_t icaches_per_tm() const {
+        return (chip.tps_per_tm + icache.threads_per_icache - 1) / icache.threads_per_icache;
+    }
 };
 
 /// Reads a TOML file over the defaults; every key is optional, unknown keys are errors.

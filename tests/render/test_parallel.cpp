@@ -210,6 +210,20 @@ TEST_CASE("host thread choice: keeps the faster count, tries the other again eve
     CHECK(one.next() == 1);
 }
 
+TEST_CASE("parallel: a finite I-cache's misses to the L2 are the same on any host threads",
+          "[parallel]") {
+    // A 1 KiB I-cache per 4 TPs thrashes on the tracer: instruction lines travel with the data
+    // lines from every TM to the L2s, in the same order for any host threads.
+    for (const Shape shape : {Shape{4, 8}, Shape{3, 5}}) {
+        INFO(shape.tms << " TMs x " << shape.tps << " TPs");
+        render::RenderOptions o = options("tracer", render::Engine::timing, shape, 16);
+        o.chip.icache.size_bytes = 1024;
+        o.chip.icache.threads_per_icache = 4;
+        o.profile = true;
+        check_same_for_any_host_threads(o);
+    }
+}
+
 TEST_CASE("parallel: the tracer on the cycle-level chip is the same on any host threads",
           "[parallel]") {
     // One TM; four; an odd count (3 TMs of 5 TPs); and 2 TMs, fewer than 3 or 8 host threads.

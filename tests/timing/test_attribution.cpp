@@ -34,6 +34,14 @@ ChipConfig odd_chip() {
     return c;
 }
 
+/// The odd chip with a small finite I-cache (2 KiB per 35 TPs): its misses add instruction
+/// lines to the L2 and DRAM traffic and fetch-miss stalls to the profile.
+ChipConfig finite_icache_chip() {
+    ChipConfig c = odd_chip();
+    apply_override(c, "icache.size_bytes=2048");
+    return c;
+}
+
 render::RenderResult render_on(const ChipConfig& chip, const char* scene, uint32_t size) {
     render::RenderOptions options;
     options.scene = scene;
@@ -48,11 +56,14 @@ render::RenderResult render_on(const ChipConfig& chip, const char* scene, uint32
 struct Stats {
     explicit Stats(const Chip& chip) : chip(chip) { chip.register_stats(registry); }
     uint64_t operator()(const std::string& name) const { return registry.at(name).integer(); }
-    /// `leaf` (e.g. "l1/reads") summed over every region, "other" included.
+    /// `leaf` (e.g. "l1/reads") summed over every region, "other" included, and a finite
+    /// I-cache's instruction lines where it has the leaf.
     uint64_t regions(const std::string& leaf) const {
         uint64_t sum = (*this)("region/other/" + leaf);
         for (const Region& r : chip.layout().regions)
             sum += (*this)("region/" + r.name + "/" + leaf);
+        if (registry.contains("region/instruction_fetch/" + leaf))
+            sum += (*this)("region/instruction_fetch/" + leaf);
         return sum;
     }
     const Chip& chip;
@@ -68,7 +79,18 @@ void check_region_totals(const Chip& chip, const ChipConfig& config) {
             CHECK(s.regions(fmt::format("{}/{}", level, leaf)) ==
                   s(fmt::format("chip/{}/{}", level, leaf)));
         }
-    CHECK(s.regions("l2/reads") == s("chip/l1/misses"));
+    const uint64_t icache_misses = config.icache.finite() ? s("chip/icache/misses") : 0;
+    CHECK(s.regions("l2/reads") == s("chip/l1/misses") + icache_misses);
+    if (config.icache.finite()) {
+        CHECK(icache_misses > 0);
+        CHECK(s("region/instruction_fetch/l2/reads") == icache_misses);
+        CHECK(s("region/instruction_fetch/l2/payload_bytes") == line * icache_misses);
+        CHECK(s("region/instruction_fetch/dram/reads") > 0);
+        CHECK(s("chip/stalls/fetch_miss") > 0);
+    } else {
+        CHECK_FALSE(s.registry.contains("chip/stalls/fetch_miss"));
+        CHECK_FALSE(s.registry.contains("region/instruction_fetch/l2/reads"));
+    }
     CHECK(s.regions("l2/writes") == s("chip/l1/writes"));
     CHECK(s.regions("dram/reads") == s("dram/reads"));
     CHECK(s.regions("dram/writes") == s("dram/writes"));
@@ -105,6 +127,8 @@ TEST_CASE("traffic by region adds up to the chip's totals", "[attribution][regio
         {"cornell, tiny chip", tiny(), TPSIM_SCENE_DIR "/cornell.toml", 32},
         {"bunny, default chip", ChipConfig{}, TPSIM_SCENE_DIR "/bunny.toml", 24},
         {"cornell, odd chip", odd_chip(), TPSIM_SCENE_DIR "/cornell.toml", 32},
+        {"cornell, odd chip, finite I-cache", finite_icache_chip(), TPSIM_SCENE_DIR "/cornell.toml",
+         32},
     };
     for (const Case& c : cases) {
         INFO(c.name);
@@ -217,7 +241,7 @@ void check_work_item_totals(const Chip& chip) {
 }  // namespace
 
 TEST_CASE("costs by work item add up to the chip's totals", "[attribution][work_items]") {
-    for (const ChipConfig& chip : {ChipConfig{}, tiny(), odd_chip()}) {
+    for (const ChipConfig& chip : {ChipConfig{}, tiny(), odd_chip(), finite_icache_chip()}) {
         const render::RenderResult result = render_on(chip, TPSIM_SCENE_DIR "/cornell.toml", 32);
         const WorkItemCosts& costs = result.timing->chip->work_items();
         REQUIRE(costs.items.size() == 32 * 32);
@@ -276,7 +300,7 @@ struct ProfiledRun {
 }  // namespace
 
 TEST_CASE("the profile by instruction adds up to the chip's totals", "[attribution][profile]") {
-    for (const ChipConfig& config : {ChipConfig{}, tiny(), odd_chip()}) {
+    for (const ChipConfig& config : {ChipConfig{}, tiny(), odd_chip(), finite_icache_chip()}) {
         const ProfiledRun run(config);
         const Chip& chip = *run.chip;
         const Stats s(chip);
@@ -295,9 +319,13 @@ TEST_CASE("the profile by instruction adds up to the chip's totals", "[attributi
         for (size_t c = 0; c < kStallCauses; ++c) {
             const std::string_view cause = render::kStallNames[c];
             INFO(cause);
-            CHECK(total.stalls[c] == s(fmt::format("chip/stalls/{}", cause)));
-            // The tracer stalls for every cause but sync: it uses no barrier or semaphore.
-            CHECK((total.stalls[c] > 0) == (Stall(c) != Stall::Sync));
+            // The tracer stalls for every cause but sync (it uses no barrier or semaphore), and
+            // for fetch misses with a finite I-cache only (which alone has the key).
+            const bool stalls =
+                Stall(c) == Stall::FetchMiss ? config.icache.finite() : Stall(c) != Stall::Sync;
+            CHECK((total.stalls[c] > 0) == stalls);
+            if (Stall(c) != Stall::FetchMiss || config.icache.finite())
+                CHECK(total.stalls[c] == s(fmt::format("chip/stalls/{}", cause)));
         }
         CHECK(total.l1_misses == s("chip/l1/misses"));
         CHECK(total.dram_bytes == s("dram/bytes_read") + s("dram/bytes_written"));

@@ -1,4 +1,4 @@
-#include "sim/timing/cache.hpp"
+#include "sim/timing/icache.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -113,14 +113,20 @@ TEST_CASE("every key a cycle-level render registers is documented in docs/statis
           "[render][docs]") {
     const std::vector<std::regex> documented = documented_stat_patterns();
     REQUIRE(documented.size() > 20);
-    const auto result = render_cornell(render::Engine::timing, tiny());
-    stats::Registry registry;
-    render::register_stats(result, registry);
-    REQUIRE(registry.contains("chip/rays_per_second"));
-    for (const stats::Entry& e : registry.entries()) {
-        INFO(e.name);
-        CHECK(std::any_of(documented.begin(), documented.end(),
-                          [&](const std::regex& re) { return std::regex_match(e.name, re); }));
+    // The finite I-cache's keys exist only with one.
+    timing::ChipConfig finite_icache = tiny();
+    timing::apply_override(finite_icache, "icache.size_bytes=1024");
+    for (const timing::ChipConfig& chip : {tiny(), finite_icache}) {
+        const auto result = render_cornell(render::Engine::timing, chip);
+        stats::Registry registry;
+        render::register_stats(result, registry);
+        REQUIRE(registry.contains("chip/rays_per_second"));
+        CHECK(registry.contains("chip/icache/misses") == chip.icache.finite());
+        for (const stats::Entry& e : registry.entries()) {
+            INFO(e.name);
+            CHECK(std::any_of(documented.begin(), documented.end(),
+                              [&](const std::regex& re) { return std::regex_match(e.name, re); }));
+        }
     }
 }
 

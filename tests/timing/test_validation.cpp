@@ -6,6 +6,7 @@
 #include "sim/timing/machine_source.hpp"
 
 #include <catch2/catch.hpp>
+#include <fmt/format.h>
 
 #include <cstring>
 #include <memory>
@@ -224,4 +225,82 @@ TEST_CASE("rdcycle reads the chip's cycle in timing mode and instret without a t
                           functional);
     machine.run();
     CHECK(uint64_t(machine.thread(0).exit_code) == kSteps + 2);
+}
+
+namespace {
+
+/// tiny with `tps` threads and a finite I-cache of 1 KiB (2 ways x 8 sets of 64-byte lines) per
+/// `per_icache` threads; the I-cache's line is the L1's.
+ChipConfig finite_icache(uint32_t tps, uint32_t per_icache) {
+    ChipConfig c = tiny(tps);
+    c.icache.threads_per_icache = per_icache;
+    c.icache.size_bytes = 1024;
+    c.icache.ways = 2;
+    c.icache.line_bytes = c.l1.line_bytes;
+    validate(c);
+    return c;
+}
+
+}  // namespace
+
+TEST_CASE("a loop larger than the I-cache misses on every line of every lap", "[validation]") {
+    // icache_thrash_<laps>: line 0, then 32 loop lines per lap, then the epilogue's line. Each
+    // of the 8 sets holds 2 of the loop's 4 lines mapping to it, fetched in cyclic order: LRU
+    // always evicts the next one needed. Each of the 4 threads has its own I-cache.
+    for (uint32_t laps : {2u, 3u}) {
+        INFO(laps << " laps");
+        const auto run = run_program(fmt::format("icache_thrash_{}", laps), finite_icache(4, 1));
+        const uint64_t per_thread = 1 + 32 * laps + 1;
+        CHECK(run->stat("tm0/icache/misses") == 4 * per_thread);
+        CHECK(run->stat("tm0/icache/merged_misses") == 0);
+        CHECK(run->stat("chip/icache/misses") == 4 * per_thread);
+        // Every miss is one line request to the L2; the 34 lines come from DRAM once (the L2
+        // holds them all).
+        CHECK(run->stat("region/instruction_fetch/l2/reads") == 4 * per_thread);
+        CHECK(run->stat("region/instruction_fetch/dram/reads") == 34);
+        CHECK(run->stat("chip/stalls/fetch_miss") > 0);
+        // Every TP-cycle is an issue or one stall, the waits for lines included.
+        uint64_t stalls = 0;
+        for (const char* cause : {"fetch_conflict", "branch", "fu_busy", "memory_port", "operand",
+                                  "sync", "fetch_miss"})
+            stalls += run->stat(fmt::format("chip/stalls/{}", cause));
+        CHECK(run->stat("chip/active_tp_cycles") == run->stat("chip/instructions") + stalls);
+    }
+}
+
+TEST_CASE("a loop that fits the I-cache misses once per line, however many threads share it",
+          "[validation]") {
+    // icache_fits_<laps>: line 0, 8 loop lines (one per set; line 0 and the epilogue's line
+    // share a set with one of them, 2 ways), the epilogue's line: 10 cold misses in all.
+    for (uint32_t laps : {2u, 3u}) {
+        INFO(laps << " laps");
+        const auto shared = run_program(fmt::format("icache_fits_{}", laps), finite_icache(4, 4));
+        CHECK(shared->stat("tm0/icache/misses") == 10);
+        CHECK(shared->stat("tm0/icache/evictions") == 0);
+        // The other three threads wait for the line the first one missed, or find it there.
+        CHECK(shared->stat("tm0/icache/merged_misses") <= 3 * 10);
+        CHECK(shared->stat("region/instruction_fetch/dram/reads") == 10);
+        const auto own = run_program(fmt::format("icache_fits_{}", laps), finite_icache(4, 1));
+        CHECK(own->stat("tm0/icache/misses") == 4 * 10);
+    }
+}
+
+TEST_CASE("an I-cache miss that hits the L2 stalls the thread 2 + l2.hit_latency cycles",
+          "[validation]") {
+    // One thread: it fetches in cycle t and misses; its line request leaves the I-cache's
+    // lookup at t + 1, the L2 hit returns it at t + 1 + l2.hit_latency, and it is forwarded to
+    // the thread a cycle later. The third lap's 32 misses all hit the L2.
+    const ChipConfig c = finite_icache(1, 1);
+    const auto two = run_program("icache_thrash_2", c);
+    const auto three = run_program("icache_thrash_3", c);
+    const uint64_t per_miss = 2 + c.l2.hit_latency;
+    CHECK(three->stat("chip/stalls/fetch_miss") - two->stat("chip/stalls/fetch_miss") ==
+          32 * per_miss);
+    // Without the I-cache's misses, the lap costs exactly that much less.
+    ChipConfig never_misses = c;
+    never_misses.icache.size_bytes = 0;
+    const uint64_t lap = three->cycles() - two->cycles();
+    const uint64_t lap_never_missing = run_program("icache_thrash_3", never_misses)->cycles() -
+                                       run_program("icache_thrash_2", never_misses)->cycles();
+    CHECK(lap == lap_never_missing + 32 * per_miss);
 }
