@@ -113,12 +113,15 @@ void print_traffic(const stats::Snapshot& snapshot, uint32_t line_bytes, std::os
                 continue;
             }
             // A finite I-cache: its hits, and its line requests to the L2 and DRAM.
-            const double waited =
-                snapshot.value("chip/icache/misses") + snapshot.value("chip/icache/merged_misses");
+            // Hits: lookups that neither missed nor found every MSHR busy.
+            const double not_hits = snapshot.value("chip/icache/misses") +
+                                    snapshot.value("chip/icache/merged_misses") +
+                                    snapshot.value("chip/icache/mshr_full");
             const double l2_reads = get(region, "l2/reads");
             fmt::print(out, "         {:<14} {:>12} {:>7} {:>10} {:>7} {:>11}  (I-cache fetches)\n",
-                       "instructions", count_text(fetches), percent_text(fetches - waited, fetches),
-                       count_text(l2_reads), percent_text(get(region, "l2/hits"), l2_reads),
+                       "instructions", count_text(fetches),
+                       percent_text(fetches - not_hits, fetches), count_text(l2_reads),
+                       percent_text(get(region, "l2/hits"), l2_reads),
                        bytes_text(get(region, "dram/reads") * line_bytes));
             continue;
         }
@@ -403,8 +406,8 @@ void print_summary(const RenderOptions& options, const RenderResult& r,
         const stats::Snapshot& v = statistics.values;
         fmt::print(
             out,
-            "icache   {} misses and {} merged misses in {} fetches ({:.2f} % waited for a "
-            "line), {} TP-cycles of fetch-miss stalls ({} of active TP-cycles)\n",
+            "icache   {} misses and {} merged misses in {} fetches ({:.2f} % missed), {} TP-cycles "
+            "of fetch-miss stalls ({} of active TP-cycles)\n",
             count_text(v.value("chip/icache/misses")),
             count_text(v.value("chip/icache/merged_misses")),
             count_text(v.value("chip/icache/fetches")), 100 * v.value("chip/icache/miss_rate"),

@@ -1335,8 +1335,8 @@ void Chip::register_stats(stats::Registry& r) const {
     };
     add_fetch_traffic("l2", l2_traffic_[fetch_region_], true);
     add_fetch_traffic("dram", dram_traffic_[fetch_region_], false);
-    r.add_sum("chip/icache/fetches", "*/icache/fetches", "instructions fetched, all TMs",
-              "instructions");
+    r.add_sum("chip/icache/fetches", "*/icache/fetches",
+              "fetches granted by the banks (lookups), all TMs", "fetches");
     for (std::string_view leaf : {"misses", "merged_misses", "mshr_full", "evictions"})
         r.add_sum(fmt::format("chip/icache/{}", leaf), fmt::format("*/icache/{}", leaf),
                   fmt::format("I-cache {}, all TMs", leaf),
@@ -1345,7 +1345,7 @@ void Chip::register_stats(stats::Registry& r) const {
         "chip/icache/miss_rate",
         {"chip/icache/misses", "chip/icache/merged_misses", "chip/icache/fetches"},
         [](Values v) { return v[2] ? (v[0] + v[1]) / v[2] : 0.0; },
-        "(misses + merged_misses) / fetches: the fetched instructions that waited for a line");
+        "(misses + merged_misses) / fetches: the I-caches' lookups that missed");
 }
 
 }  // namespace tpsim::timing

@@ -13,7 +13,9 @@ ICacheBanks::ICacheBanks(const ICacheConfig& config, uint32_t num_threads)
 }
 
 void ICacheBanks::register_stats(stats::Registry& r, std::string_view prefix) const {
-    r.add_counter(fmt::format("{}/fetches", prefix), counters_.fetches, "instructions fetched");
+    r.add_counter(
+        fmt::format("{}/fetches", prefix), counters_.fetches,
+        "fetches granted (an instruction each, and a finite I-cache's lookups that missed)");
     r.add_counter(fmt::format("{}/conflicts", prefix), counters_.conflicts,
                   "fetches refused by an I-cache bank conflict (one cycle lost each)");
 }

@@ -49,6 +49,14 @@ TEST_CASE("cross-field rules are checked", "[config]") {
                       Contains("must equal l1.line_bytes"));
     CHECK_THROWS_WITH(parse_config("[l1]\nline_bytes = 48\n", "x.toml"), Contains("power of two"));
     CHECK_THROWS_WITH(parse_config("[dram]\ntRAS = 5\n", "x.toml"), Contains("dram.tRAS"));
+    // A finite I-cache's geometry is checked as the data caches'; with size_bytes = 0 (never
+    // misses) its other fields take no part.
+    CHECK_THROWS_WITH(parse_config("[icache]\nsize_bytes = 3000\n", "x.toml"),
+                      Contains("icache.size_bytes = 3000 must be a power-of-two multiple"));
+    CHECK_THROWS_WITH(parse_config("[icache]\nsize_bytes = 4096\nline_bytes = 128\n", "x.toml"),
+                      Contains("icache.line_bytes = 128 must equal l1.line_bytes = 64"));
+    CHECK_NOTHROW(parse_config("[icache]\nsize_bytes = 0\nline_bytes = 128\n", "x.toml"));
+    CHECK_NOTHROW(parse_config("[icache]\nsize_bytes = 1024\nways = 16\n", "x.toml"));
 }
 
 TEST_CASE("a chip that needs too much host memory is refused with the figure and the field",
@@ -63,6 +71,9 @@ TEST_CASE("a chip that needs too much host memory is refused with the figure and
     big.chip.num_tms = 16;  // 4 GiB of L1 tags: allowed
     CHECK_NOTHROW(validate(big));
     CHECK_THROWS_WITH(apply_override(big, "chip.num_tms=64"), Contains("l1.size_bytes"));
+    // The I-caches' tags count too: 2 per TM of 32 TPs, 2^24 lines each, 16 TMs: 8 GiB more.
+    big.icache.size_bytes = 1u << 30;
+    CHECK_THROWS_WITH(validate(big), Contains("reduce icache.size_bytes"));
 }
 
 TEST_CASE("overrides set one field with the same validation", "[config]") {
@@ -89,6 +100,7 @@ TEST_CASE("the printed config lists every key and parses back to the same config
     apply_override(c, "dram.tCL=20");
     apply_override(c, "fu.atomic.pipelined=false");
     apply_override(c, "l2.write_combining_lines=8");
+    apply_override(c, "icache.size_bytes=4096");
     const std::string text = to_toml(c);
     const std::vector<ConfigField> fields = config_fields(c);
     for (const ConfigField& field : fields) {
@@ -96,7 +108,7 @@ TEST_CASE("the printed config lists every key and parses back to the same config
         CHECK(text.find(leaf) != std::string::npos);
     }
     CHECK(parse_config(text, "printed") == c);
-    CHECK(fields.size() == 4 + 4 + 9 * 3 + 2 + 2 * 6 + 1 + 15 + 3 + 20 + 16);
+    CHECK(fields.size() == 4 + 4 + 9 * 3 + 6 + 2 * 6 + 1 + 15 + 3 + 20 + 16);
     // The fields carry the resolved values, bools as 0/1.
     const auto field = [&](std::string_view key) {
         return *std::find_if(fields.begin(), fields.end(),
