@@ -57,19 +57,24 @@ CacheOutcome Cache::access(uint64_t now, const MemRequest& request) {
         outbound_.push_back({after_lookup, request});
         return CacheOutcome::WriteForward;
     }
-    const CacheOutcome outcome = read(now, request, true);
+    const CacheOutcome outcome = read<true>(now, request);
     if (outcome != CacheOutcome::MshrFull) bank_used = now;
     return outcome;
 }
 
-CacheOutcome Cache::read(uint64_t now, const MemRequest& request, bool reply_on_hit) {
+CacheOutcome Cache::fetch(uint64_t now, const MemRequest& request) {
+    return read<false>(now, request);
+}
+
+template <bool kReplyOnHit>
+[[gnu::always_inline]] inline CacheOutcome Cache::read(uint64_t now, const MemRequest& request) {
     const uint32_t line = line_of(request.addr);
     const uint64_t after_lookup = now + config_.hit_latency;
     if (Way* way = find(line)) {
         ++counters_.reads;
         ++counters_.hits;
         way->last_use = ++use_clock_;
-        if (reply_on_hit) replies_.push_back({after_lookup, request});
+        if constexpr (kReplyOnHit) replies_.push_back({after_lookup, request});
         return CacheOutcome::Hit;
     }
     Mshr* free_mshr = nullptr;

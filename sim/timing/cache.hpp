@@ -70,9 +70,7 @@ public:
     /// An instruction fetch (a finite I-cache's tags, ICacheLines): the caller has arbitrated
     /// the banks, and a hit queues no reply (the fetch goes on in this cycle); a miss is a
     /// load's miss.
-    CacheOutcome fetch(uint64_t now, const MemRequest& request) {
-        return read(now, request, false);
-    }
+    CacheOutcome fetch(uint64_t now, const MemRequest& request);
     /// The line holding `line_addr` arrives from the next level in cycle `now`: it is
     /// installed (evicting the LRU way) and every merged waiter gets a reply at now + hit_latency.
     void fill(uint64_t now, uint32_t line_addr);
@@ -125,8 +123,8 @@ private:
     };
 
     Way* find(uint32_t line);
-    /// A load whose bank is free: a hit (with a reply if `reply_on_hit`), a miss or a merge.
-    CacheOutcome read(uint64_t now, const MemRequest& request, bool reply_on_hit);
+    /// A load whose bank is free: a hit (with a reply if kReplyOnHit), a miss or a merge.
+    template <bool kReplyOnHit> CacheOutcome read(uint64_t now, const MemRequest& request);
     /// Puts `line` (not present) into the LRU way of its set; returns whether it evicted one.
     bool install(uint32_t line);
     CacheOutcome combine(uint64_t now, const MemRequest& request);

@@ -149,18 +149,23 @@ struct alignas(64) Chip::Tm {
                 pc->stalls[size_t(Stall::Sync)] += waited;
         tp.wake_at = now;
     }
-    /// A finite I-cache's reply: the line TP i missed on has arrived (forwarded to it), so it
-    /// fetches again, with fetch-miss stall cycles from the cycle of its miss.
-    void wake_from_fetch(uint32_t i, uint32_t pc, uint64_t now) {
-        Tp& tp = tps[i];
-        set_bit(awake_tps, i);
-        const uint64_t waited = now - tp.asleep_from;
-        counters.active_tp_cycles += waited;
-        counters.stalls[size_t(Stall::FetchMiss)] += waited;
-        if (profile)
-            if (PcCounters* counters_at = profile->at(pc))
-                counters_at->stalls[size_t(Stall::FetchMiss)] += waited;
-        tp.wake_at = now;
+    /// A finite I-cache's replies by `now`: the line each TP missed on has arrived (forwarded
+    /// to it), so it fetches again, with fetch-miss stall cycles from the cycle of its miss.
+    /// Out of line: receive() stays small without a finite I-cache.
+    [[gnu::noinline]] void wake_from_fetches(uint64_t now) {
+        MemReply reply;
+        while (lines->pop_reply(now, reply)) {
+            Tp& tp = tps[reply.request.source];
+            set_bit(awake_tps, reply.request.source);
+            const uint64_t waited = now - tp.asleep_from;
+            counters.active_tp_cycles += waited;
+            counters.stalls[size_t(Stall::FetchMiss)] += waited;
+            if (profile)
+                if (PcCounters* pc = profile->at(reply.request.pc))
+                    pc->stalls[size_t(Stall::FetchMiss)] += waited;
+            tp.wake_at = now;
+            ++progress;
+        }
     }
     /// Start of cycle `now`: L2 fills, global-register replies, then the L1's and the finite
     /// I-cache's replies.
@@ -169,7 +174,7 @@ struct alignas(64) Chip::Tm {
             if (fills.front().icache == kDataLine) [[likely]]
                 l1.fill(now, fills.front().line);
             else
-                lines->fill(now, fills.front().icache, fills.front().line);
+                lines->fill(now, fills.front().icache, fills.front().line);  // out of line
         for (; !replies.empty() && replies.front().ready <= now; replies.pop_front()) {
             const AtomicRequest& atomic = replies.front().request;
             if (atomic.kind == GlobalRequest::Increment) [[likely]] {
@@ -187,10 +192,7 @@ struct alignas(64) Chip::Tm {
             ++progress;
         }
         if (lines) [[unlikely]]
-            while (lines->pop_reply(now, reply)) {
-                wake_from_fetch(reply.request.source, reply.request.pc, now);
-                ++progress;
-            }
+            wake_from_fetches(now);
     }
     /// TP i leaves the awake set until cycle `at` (> now), when the wheel puts it back. A
     /// sleep longer than the wheel (configs with huge latencies) waits in the wheel's last slot
