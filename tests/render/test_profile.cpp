@@ -32,8 +32,9 @@ const core::Segment& text_of(const core::Program& program) {
 }
 
 /// Every word of the text costed, each differently: executions = word index + 1, and stalls,
-/// misses and bytes that vary independently of it.
-timing::PcProfile synthetic_profile(const core::Program& program) {
+/// misses and bytes that vary independently of it; fetch-miss stalls (a finite I-cache's) only
+/// if `fetch_misses`.
+timing::PcProfile synthetic_profile(const core::Program& program, bool fetch_misses = true) {
     const core::Segment& text = text_of(program);
     timing::PcProfile profile;
     profile.text = {{text.vaddr, text.memsz / 4}};
@@ -43,6 +44,7 @@ timing::PcProfile synthetic_profile(const core::Program& program) {
         w.executions = i + 1;
         for (size_t cause = 0; cause < timing::kStallCauses; ++cause)
             w.stalls[cause] = (i * (cause + 3)) % 17;
+        if (!fetch_misses) w.stalls[size_t(timing::Stall::FetchMiss)] = 0;
         w.l1_misses = i % 3;
         w.dram_bytes = (i % 5) * 32;
     }
@@ -200,70 +202,84 @@ TEST_CASE("profile: words without a function or a line go to one (unknown) entry
 }
 
 TEST_CASE("profile: the JSON object has the statistics file's shape", "[profile]") {
-    const render::Profile p = render::profile_of(synthetic_profile(tracer()), tracer());
-    const nlohmann::ordered_json json = render::profile_json(p);
-    std::vector<std::string> keys;
-    for (const auto& [key, value] : json.items())
-        keys.push_back(key);
-    CHECK(keys == std::vector<std::string>{"total_cycles", "functions", "lines"});
-    CHECK(json["total_cycles"] == p.total.cycles);
-    REQUIRE(json["functions"].size() == p.functions.size());
-    REQUIRE(json["lines"].size() == p.lines.size());
+    for (const bool fetch_misses : {true, false}) {
+        INFO("fetch misses " << fetch_misses);
+        const render::Profile p =
+            render::profile_of(synthetic_profile(tracer(), fetch_misses), tracer());
+        const nlohmann::ordered_json json = render::profile_json(p);
+        std::vector<std::string> keys;
+        for (const auto& [key, value] : json.items())
+            keys.push_back(key);
+        CHECK(keys == std::vector<std::string>{"total_cycles", "functions", "lines"});
+        CHECK(json["total_cycles"] == p.total.cycles);
+        REQUIRE(json["functions"].size() == p.functions.size());
+        REQUIRE(json["lines"].size() == p.lines.size());
 
-    const auto& top = json["functions"][0];
-    std::vector<std::string> entry_keys;
-    for (const auto& [key, value] : top.items())
-        entry_keys.push_back(key);
-    CHECK(entry_keys == std::vector<std::string>{"function", "executions", "cycles", "stalls",
-                                                 "l1_misses", "dram_bytes"});
-    CHECK(top["function"] == p.functions[0].function);
-    CHECK(top["cycles"] == p.functions[0].costs.cycles);
-    size_t cause = 0;
-    for (const auto& [name, value] : top["stalls"].items()) {
-        CHECK(name == render::kStallNames[cause]);
-        CHECK(value == p.functions[0].costs.stalls[cause]);
-        ++cause;
+        const auto& top = json["functions"][0];
+        std::vector<std::string> entry_keys;
+        for (const auto& [key, value] : top.items())
+            entry_keys.push_back(key);
+        CHECK(entry_keys == std::vector<std::string>{"function", "executions", "cycles", "stalls",
+                                                     "l1_misses", "dram_bytes"});
+        CHECK(top["function"] == p.functions[0].function);
+        CHECK(top["cycles"] == p.functions[0].costs.cycles);
+        size_t cause = 0;
+        for (const auto& [name, value] : top["stalls"].items()) {
+            CHECK(name == render::kStallNames[cause]);
+            CHECK(value == p.functions[0].costs.stalls[cause]);
+            ++cause;
+        }
+        // fetch_miss (the last cause) only with fetch-miss stalls, i.e. with a finite I-cache.
+        CHECK(cause == (fetch_misses ? timing::kStallCauses : size_t(timing::Stall::FetchMiss)));
+
+        const auto& line = json["lines"][0];
+        std::vector<std::string> line_keys;
+        for (const auto& [key, value] : line.items())
+            line_keys.push_back(key);
+        CHECK(line_keys == std::vector<std::string>{"file", "line", "function", "executions",
+                                                    "cycles", "stalls", "l1_misses", "dram_bytes"});
+        CHECK(line["file"] == p.lines[0].file);
+        CHECK(line["line"] == p.lines[0].line);
+        uint64_t cycles = 0;
+        for (const auto& l : json["lines"])
+            cycles += l["cycles"].get<uint64_t>();
+        CHECK(cycles == json["total_cycles"]);
     }
-    // fetch_miss only with a finite I-cache (this profile has no fetch-miss stalls).
-    CHECK(cause == size_t(timing::Stall::FetchMiss));
-
-    const auto& line = json["lines"][0];
-    std::vector<std::string> line_keys;
-    for (const auto& [key, value] : line.items())
-        line_keys.push_back(key);
-    CHECK(line_keys == std::vector<std::string>{"file", "line", "function", "executions", "cycles",
-                                                "stalls", "l1_misses", "dram_bytes"});
-    CHECK(line["file"] == p.lines[0].file);
-    CHECK(line["line"] == p.lines[0].line);
-    uint64_t cycles = 0;
-    for (const auto& l : json["lines"])
-        cycles += l["cycles"].get<uint64_t>();
-    CHECK(cycles == json["total_cycles"]);
 }
 
 TEST_CASE("profile: the report section names the hottest entries in 100 columns", "[profile]") {
-    const render::Profile p = render::profile_of(synthetic_profile(tracer()), tracer());
-    std::ostringstream out;
-    render::print_profile(p, out);
-    const std::string text = out.str();
-    INFO(text);
-    std::istringstream lines(text);
-    size_t rows = 0;
-    for (std::string row; std::getline(lines, row); ++rows)
-        CHECK(row.size() <= 100);
-    // A head of three lines, two table heads, 10 functions (or all) and 15 lines.
-    CHECK(rows == 3 + 2 + std::min<size_t>(10, p.functions.size()) + 15);
-    CHECK(text.find(std::to_string(p.total.cycles)) != std::string::npos);
-    const std::string name = render::short_function_name(p.functions[0].function);
-    CHECK(text.find(name) != std::string::npos);
-    // The head names every column: its "function" stands above the rows' names, one stall
-    // column per cause between them.
-    const size_t head = text.find("function (top");
-    const size_t line_start = text.rfind('\n', head) + 1;
-    const size_t row_start = text.find('\n', head) + 1;
-    CHECK(head - line_start == text.find(name, row_start) - row_start);
-    const std::string hottest_line = p.lines[0].file + ":" + std::to_string(p.lines[0].line) + " ";
-    CHECK(text.find(hottest_line) != std::string::npos);
+    // With fetch-miss stalls (a finite I-cache) one more stall column, and its name in the head.
+    for (const bool fetch_misses : {false, true}) {
+        INFO("fetch misses " << fetch_misses);
+        const render::Profile p =
+            render::profile_of(synthetic_profile(tracer(), fetch_misses), tracer());
+        std::ostringstream out;
+        render::print_profile(p, out);
+        const std::string text = out.str();
+        INFO(text);
+        std::istringstream lines(text);
+        size_t rows = 0;
+        for (std::string row; std::getline(lines, row); ++rows)
+            CHECK(row.size() <= 100);
+        // A head of three lines (four with fetch misses), two table heads, 10 functions (or all)
+        // and 15 lines.
+        CHECK(rows == (fetch_misses ? 4 : 3) + 2 + std::min<size_t>(10, p.functions.size()) + 15);
+        CHECK(text.find(std::to_string(p.total.cycles)) != std::string::npos);
+        CHECK((text.find(" fmi ") != std::string::npos) == fetch_misses);
+        // Names take 38 columns, 34 beside the fetch-miss column (cut with "...").
+        std::string name = render::short_function_name(p.functions[0].function);
+        if (fetch_misses && name.size() > 34) name = name.substr(0, 31) + "...";
+        CHECK(text.find(name) != std::string::npos);
+        // The head names every column: its "function" stands above the rows' names, one stall
+        // column per cause between them.
+        const size_t head = text.find("function (top");
+        const size_t line_start = text.rfind('\n', head) + 1;
+        const size_t row_start = text.find('\n', head) + 1;
+        CHECK(head - line_start == text.find(name, row_start) - row_start);
+        const std::string hottest_line =
+            p.lines[0].file + ":" + std::to_string(p.lines[0].line) + " ";
+        CHECK(text.find(hottest_line) != std::string::npos);
+    }
 }
 
 TEST_CASE("profile: short function names drop return types, parameters and namespaces of "
