@@ -20,13 +20,6 @@ Cache::Cache(const CacheConfig& config, uint32_t write_combining_lines)
             "Cache: invalid geometry; validate the ChipConfig before building caches");
 }
 
-Cache::Way* Cache::find(uint32_t line) {
-    Way* set = &ways_[size_t{set_of(line)} * config_.ways];
-    for (uint32_t w = 0; w < config_.ways; ++w)
-        if (set[w].valid && set[w].line == line) return &set[w];
-    return nullptr;
-}
-
 const Cache::Way* Cache::find(uint32_t line) const {
     return const_cast<Cache*>(this)->find(line);
 }
@@ -62,7 +55,7 @@ CacheOutcome Cache::access(uint64_t now, const MemRequest& request) {
     return outcome;
 }
 
-CacheOutcome Cache::fetch(uint64_t now, const MemRequest& request) {
+CacheOutcome Cache::fetch_miss(uint64_t now, const MemRequest& request) {
     return read<false>(now, request);
 }
 

@@ -22,22 +22,11 @@ void ICacheBanks::register_stats(stats::Registry& r, std::string_view prefix) co
 
 ICacheLines::ICacheLines(const ICacheConfig& config, uint32_t num_threads, uint8_t region)
     : threads_per_icache_(config.threads_per_icache), region_(region),
-      forwarded_(num_threads, kNoLine) {
+      forwarded_(num_threads, kNoLine), way_hints_(num_threads, 0) {
     const uint32_t caches =
         (num_threads + config.threads_per_icache - 1) / config.threads_per_icache;
     for (uint32_t c = 0; c < caches; ++c)
         caches_.emplace_back(icache_lines_config(config));
-}
-
-CacheOutcome ICacheLines::fetch(uint64_t now, uint32_t tp, uint32_t pc, uint32_t item) {
-    Cache& cache = caches_[tp / threads_per_icache_];
-    if (std::exchange(forwarded_[tp], kNoLine) == cache.line_of(pc)) return CacheOutcome::Hit;
-    const MemRequest request{pc, tp, tp / threads_per_icache_, false, region_, 4, pc, item};
-    const CacheOutcome outcome = cache.fetch(now, request);
-    counters_.misses += outcome == CacheOutcome::Miss;
-    counters_.merged_misses += outcome == CacheOutcome::MergedMiss;
-    counters_.mshr_full += outcome == CacheOutcome::MshrFull;
-    return outcome;
 }
 
 void ICacheLines::send(std::deque<OutboundRequest>& to) {

@@ -90,7 +90,16 @@ public:
 
     /// TP `tp`, holding work item `item`, fetches `pc` in cycle `now` (its bank granted): Hit,
     /// Miss or MergedMiss (the TP waits for pop_reply), or MshrFull (it retries).
-    CacheOutcome fetch(uint64_t now, uint32_t tp, uint32_t pc, uint32_t item);
+    CacheOutcome fetch(uint64_t now, uint32_t tp, uint32_t pc, uint32_t item) {
+        Cache& cache = caches_[tp / threads_per_icache_];
+        if (std::exchange(forwarded_[tp], kNoLine) == cache.line_of(pc)) return CacheOutcome::Hit;
+        const MemRequest request{pc, tp, tp / threads_per_icache_, false, region_, 4, pc, item};
+        const CacheOutcome outcome = cache.fetch(now, request, way_hints_[tp]);
+        counters_.misses += outcome == CacheOutcome::Miss;
+        counters_.merged_misses += outcome == CacheOutcome::MergedMiss;
+        counters_.mshr_full += outcome == CacheOutcome::MshrFull;
+        return outcome;
+    }
     /// Moves the line requests made so far to `to` (the TM's queue to the L2), in order. Each
     /// carries the instruction-fetch region and, as its tag, the I-cache's index in the TM.
     void send(std::deque<OutboundRequest>& to);
@@ -109,6 +118,7 @@ private:
     uint8_t region_;
     std::vector<Cache> caches_;
     std::vector<uint32_t> forwarded_;  // per TP: the line its last reply brought, or kNoLine
+    std::vector<uint32_t> way_hints_;  // per TP: Cache::fetch's way_hint
     Counters counters_;
 };
 
