@@ -26,7 +26,7 @@ constexpr uint64_t kNever = UINT64_MAX;
 /// reply wakes it (Tm::wake_from_sync), not the replies wake() serves.
 constexpr uint64_t kSyncWait = kNever - 1;
 /// wake_at of a TP waiting for an instruction line (a finite I-cache's miss): only the I-cache's
-/// reply wakes it (Tm::wake_from_fetch).
+/// reply wakes it (Tm::wake_from_fetches).
 constexpr uint64_t kFetchWait = kNever - 2;
 constexpr uint64_t kDeadlockCycles = 1'000'000;
 constexpr size_t kPools = static_cast<size_t>(Pool::Count);
