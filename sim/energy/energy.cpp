@@ -152,11 +152,17 @@ Estimate estimate(const timing::ChipConfig& chip, const Events& events) {
          events.local_store_accesses * pj(energy_of(e.local_store_access_pj, ls, ls_default, 1, 1)),
          tps * mm2(area_of(a.local_store_um2, ls, ls_default, 1, 1))});
     const double ib = chip.icache.banks, ib_default = defaults.icache.banks;
+    // The cited I-cache holds 4 KiB (TRaX's, which never misses: icache.size_bytes = 0); a
+    // finite I-cache scales from it.
+    constexpr double kCitedIcacheBytes = 4096;
+    const double is = chip.icache.finite() ? chip.icache.size_bytes : kCitedIcacheBytes;
     out.parts.push_back(
-        {"icaches", "instruction caches", "fetches x energy.icache_fetch_pj scaled to icache.banks",
-         "I-caches x area.icache_um2 scaled to icache.banks",
-         events.icache_fetches * pj(energy_of(e.icache_fetch_pj, 1, 1, ib, ib_default)),
-         icaches * mm2(area_of(a.icache_um2, 1, 1, ib, ib_default))});
+        {"icaches", "instruction caches",
+         "fetches x energy.icache_fetch_pj scaled to icache.size_bytes and icache.banks",
+         "I-caches x area.icache_um2 scaled to icache.size_bytes and icache.banks",
+         events.icache_fetches *
+             pj(energy_of(e.icache_fetch_pj, is, kCitedIcacheBytes, ib, ib_default)),
+         icaches * mm2(area_of(a.icache_um2, is, kCitedIcacheBytes, ib, ib_default))});
     const auto cache_part = [&](std::string name, const timing::CacheConfig& c,
                                 const timing::CacheConfig& d, double accesses, double access_pj,
                                 double um2, double count) {

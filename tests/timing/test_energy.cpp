@@ -160,6 +160,26 @@ TEST_CASE("SRAM costs scale from the default geometry by the fitted power law", 
     };
     CHECK(part("l1").joules == Approx(1000 * e * 1e-12).epsilon(1e-12));
     CHECK(part("l1").area_mm2 == Approx(a * 1e-6).epsilon(1e-12));
+
+    // The I-cache's cited 4 KiB is what an I-cache that never misses (size_bytes = 0) costs; a
+    // finite one of 16 KiB scales from it.
+    events = {};
+    events.icache_fetches = 1000;
+    const auto icache_part = [&](const ChipConfig& chip) {
+        for (const energy::Part& p : energy::estimate(chip, events).parts)
+            if (p.name == "icaches") return p;
+        FAIL("no icaches part");
+        return energy::Part{};
+    };
+    ChipConfig icache = one_tp();
+    const energy::Part never_misses = icache_part(icache);
+    icache.icache.size_bytes = 4096;
+    CHECK(icache_part(icache).joules == never_misses.joules);
+    icache.icache.size_bytes = 16384;
+    CHECK(icache_part(icache).joules ==
+          Approx(never_misses.joules * std::pow(4.0, c.energy.sram_size_exponent)).epsilon(1e-12));
+    CHECK(icache_part(icache).area_mm2 ==
+          Approx(never_misses.area_mm2 * std::pow(4.0, c.area.sram_size_exponent)).epsilon(1e-12));
 }
 
 TEST_CASE("DRAM energy is per activate and per line, scaled to the line size", "[energy]") {
