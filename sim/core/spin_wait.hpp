@@ -65,12 +65,7 @@ public:
         const uint32_t phase = phase_.load(std::memory_order_acquire);
         const uint32_t count = count_.load(std::memory_order_relaxed);
         spin_until([&] { return arrived_.load(std::memory_order_acquire) + 1 == count; }, spins_);
-        completion_();
-        count_.store(count - dropping_.exchange(0, std::memory_order_relaxed),
-                     std::memory_order_relaxed);
-        arrived_.store(0, std::memory_order_relaxed);
-        phase_.store(phase + 1, std::memory_order_release);
-        phase_.notify_all();
+        complete(phase, count);
     }
     /// Arrives without waiting, and leaves: later phases wait for one thread fewer.
     void arrive_and_drop() { arrive(true); }
@@ -82,12 +77,7 @@ private:
         const uint32_t count = count_.load(std::memory_order_relaxed);
         if (drop) dropping_.fetch_add(1, std::memory_order_relaxed);
         if (arrived_.fetch_add(1, std::memory_order_acq_rel) + 1 == count) {
-            completion_();
-            count_.store(count - dropping_.exchange(0, std::memory_order_relaxed),
-                         std::memory_order_relaxed);
-            arrived_.store(0, std::memory_order_relaxed);  // both published by the release below
-            phase_.store(phase + 1, std::memory_order_release);
-            phase_.notify_all();  // no system call unless a thread sleeps
+            complete(phase, count);
         } else if (!drop) {
             for (uint32_t tries = 0; phase_.load(std::memory_order_acquire) == phase; ++tries)
                 if (tries < spins_)
@@ -95,6 +85,16 @@ private:
                 else
                     phase_.wait(phase, std::memory_order_acquire);
         }
+    }
+
+    /// Every thread of `phase` has arrived: runs the completion, then lets them go.
+    void complete(uint32_t phase, uint32_t count) {
+        completion_();
+        count_.store(count - dropping_.exchange(0, std::memory_order_relaxed),
+                     std::memory_order_relaxed);
+        arrived_.store(0, std::memory_order_relaxed);  // both published by the release below
+        phase_.store(phase + 1, std::memory_order_release);
+        phase_.notify_all();  // no system call unless a thread sleeps
     }
 
     const uint32_t spins_;
