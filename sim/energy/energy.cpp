@@ -13,28 +13,10 @@ namespace {
 
 constexpr size_t kPools = size_t(timing::Pool::Count);
 
-/// Like stats::matches, but a segment "tm*" stands for one TM ("tm" and digits) only, so a
-/// chip-wide sum added later ("chip/...") is never counted twice.
-bool source_matches(std::string_view pattern, std::string_view name) {
-    while (true) {
-        const size_t p_end = pattern.find('/');
-        const size_t n_end = name.find('/');
-        const std::string_view p_seg = pattern.substr(0, p_end);
-        const std::string_view n_seg = name.substr(0, n_end);
-        const bool tm = p_seg == "tm*" && n_seg.size() > 2 && n_seg.starts_with("tm") &&
-                        n_seg.find_first_not_of("0123456789", 2) == std::string_view::npos;
-        if (!tm && p_seg != n_seg) return false;
-        if (p_end == std::string_view::npos || n_end == std::string_view::npos)
-            return p_end == n_end;
-        pattern.remove_prefix(p_end + 1);
-        name.remove_prefix(n_end + 1);
-    }
-}
-
 /// The source an input statistic feeds, if any.
 const EventSource* source_of(std::string_view name) {
     for (const EventSource& source : event_sources())
-        if (source_matches(source.pattern, name)) return &source;
+        if (stats::matches(source.pattern, name)) return &source;
     return nullptr;
 }
 

@@ -46,7 +46,9 @@ bool matches(std::string_view pattern, std::string_view name) {
         const size_t n_end = name.find('/');
         const std::string_view p_seg = pattern.substr(0, p_end);
         const std::string_view n_seg = name.substr(0, n_end);
-        if (p_seg != "*" && p_seg != n_seg) return false;
+        const bool one_tm = p_seg == "tm*" && n_seg.size() > 2 && n_seg.starts_with("tm") &&
+                            n_seg.find_first_not_of("0123456789", 2) == std::string_view::npos;
+        if (p_seg != "*" && !one_tm && p_seg != n_seg) return false;
         if (p_end == std::string_view::npos || n_end == std::string_view::npos)
             return p_end == n_end;
         pattern.remove_prefix(p_end + 1);

@@ -66,8 +66,8 @@ public:
     /// numerator / denominator of two already registered entries; 0 when the denominator is 0.
     void add_ratio(std::string name, std::string_view numerator, std::string_view denominator,
                    std::string description, std::string unit = "");
-    /// Sum of every already registered entry whose name matches `pattern`, where a '*' segment
-    /// matches any one segment ("tm*/l1/misses"). An integer when all parts are integers.
+    /// Sum of every already registered entry whose name matches `pattern` (matches: "*/l1/misses",
+    /// "tm*/l1/misses"). An integer when all parts are integers.
     /// Throws std::invalid_argument if nothing matches.
     void add_sum(std::string name, std::string_view pattern, std::string description,
                  std::string unit = "");
@@ -88,7 +88,8 @@ private:
     std::vector<Entry> entries_;
 };
 
-/// True when `name` matches `pattern` segment by segment ('*' matches one whole segment).
+/// True when `name` matches `pattern` segment by segment: '*' matches any one segment, "tm*"
+/// one TM's ("tm" and digits, so never a chip-wide "chip/..." sum).
 bool matches(std::string_view pattern, std::string_view name);
 
 /// One statistic's value at one moment.

@@ -35,6 +35,10 @@ TEST_CASE("pattern matching is by whole segments", "[stats]") {
     CHECK_FALSE(matches("*/l1/misses", "tm3/l1/misses/x"));
     CHECK_FALSE(matches("*/l1/misses", "l1/misses"));
     CHECK_FALSE(matches("*/l1/misses", "tm3/l2/misses"));
+    CHECK(matches("tm*/l1/misses", "tm12/l1/misses"));
+    CHECK_FALSE(matches("tm*/l1/misses", "chip/l1/misses"));
+    CHECK_FALSE(matches("tm*/l1/misses", "tm/l1/misses"));
+    CHECK_FALSE(matches("tm*/l1/misses", "tm3x/l1/misses"));
 }
 
 TEST_CASE("ratios and sums aggregate over components", "[stats]") {
