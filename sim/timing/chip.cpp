@@ -3,6 +3,7 @@
 #include "kernel/memory_map.hpp"
 #include "sim/core/ordered_turns.hpp"
 #include "sim/timing/bits.hpp"
+#include "sim/timing/epoch_cycles.hpp"
 #include "sim/timing/machine_source.hpp"
 
 #include <fmt/format.h>
@@ -74,9 +75,14 @@ struct alignas(64) Chip::Tm {
     // i of word i / 64); the rest of a TP's state is in Tp.
     using TpBits = std::vector<uint64_t>;
     struct Tp {
+        // The hot part first: read for every awake TP in every cycle.
         StepInfo pending;  // fetched, not yet issued (bit in pending_tps)
         Pool pending_pool{};
-        Pool asleep_on{};          // the producing pool a reply-wait is attributed to
+        Pool asleep_on{};  // the producing pool a reply-wait is attributed to
+        // Cycle each register becomes readable, as an offset from the TM's epoch; the extra last
+        // slot is isa::kNoReg (an unused operand) and stays 0, so the scoreboard check needs no
+        // branch per operand.
+        std::array<uint32_t, isa::kNumRegs + 1> reg_ready{};
         uint64_t wake_at = 0;      // asleep until this cycle (kNever: until a reply for it)
         uint64_t asleep_from = 0;  // first uncounted cycle of a reply-wait
         uint64_t mem_at = 0;       // a granted load/store's first cycle at the L1
@@ -87,9 +93,6 @@ struct alignas(64) Chip::Tm {
         uint32_t item = UINT32_MAX;
         uint64_t item_since = 0;
         uint64_t item_instructions = 0;
-        // Cycle each register becomes readable; the extra last slot is isa::kNoReg (an unused
-        // operand) and stays 0, so the scoreboard check needs no branch per operand.
-        std::array<uint64_t, isa::kNumRegs + 1> reg_ready{};
         std::array<Pool, isa::kNumRegs> reg_producer{};  // pool that will write it
     };
     struct Counters {
@@ -120,6 +123,14 @@ struct alignas(64) Chip::Tm {
             pools.emplace_back(pool_config(c.fu, Pool(p)), c.chip.tps_per_tm);
     }
 
+    /// Start of cycle `now`: every two billion cycles, the scoreboards' epoch moves.
+    void keep_epoch_near(uint64_t now) {
+        if (epoch.due(now)) [[unlikely]]
+            epoch.move_to(now, [&](auto&& shift) {
+                for (Tp& tp : tps)
+                    shift(tp.reg_ready);
+            });
+    }
     void add_operand_stalls(Pool blocking, uint64_t cycles) {
         counters.active_tp_cycles += cycles;
         counters.stalls[size_t(Stall::Operand)] += cycles;
@@ -178,7 +189,7 @@ struct alignas(64) Chip::Tm {
         for (; !replies.empty() && replies.front().ready <= now; replies.pop_front()) {
             const AtomicRequest& atomic = replies.front().request;
             if (atomic.kind == GlobalRequest::Increment) [[likely]] {
-                tps[atomic.tp].reg_ready[atomic.tag] = now;
+                tps[atomic.tp].reg_ready[atomic.tag] = epoch.offset(now);
                 wake(atomic.tp, now);
             } else {
                 wake_from_sync(atomic.tp, now);
@@ -187,7 +198,7 @@ struct alignas(64) Chip::Tm {
         }
         MemReply reply;
         while (l1.pop_reply(now, reply)) {
-            tps[reply.request.source].reg_ready[reply.request.tag] = now;
+            tps[reply.request.source].reg_ready[reply.request.tag] = epoch.offset(now);
             wake(reply.request.source, now);
             ++progress;
         }
@@ -222,7 +233,8 @@ struct alignas(64) Chip::Tm {
     }
 
     uint32_t id;
-    uint32_t words;  // 64-bit words of a TpBits
+    uint32_t words;     // 64-bit words of a TpBits
+    EpochCycles epoch;  // of the TPs' scoreboards
     std::vector<Tp> tps;
     std::vector<FuPool> pools;
     ICacheBanks icache;
@@ -822,6 +834,7 @@ void Chip::wait_turn(const Tm& tm, uint64_t now) {
 template <class Source> void Chip::tm_cycle(Tm& tm, uint64_t now, Source& source) {
     clocks_[tm.id].now = now;
     const uint64_t progress = tm.progress;
+    tm.keep_epoch_near(now);
     tm.receive(now);
     // TMs of up to 64 TPs (one word per bit set) take a loop without word loops; the
     // profile's bookkeeping is compiled in only where it is collected.
@@ -953,6 +966,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
     // shared-memory effects must happen in fetch order): it goes in rotating order. On several
     // host threads, the first step that is not private waits for this TM's turn in the cycle.
     tm.wake_timed(now);
+    const uint32_t now_offset = tm.epoch.offset(now);
     Tm::Tp* const tps = tm.tps.data();
     const uint32_t first_thread = tm.id * n;
     auto& counters = tm.counters;
@@ -1008,10 +1022,10 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
         std::array<uint64_t, kPools> asking{};  // this word's requesters, by pool
         for_each_bit(w, holding, [&](uint32_t i) {
             const isa::Decoded& d = *tps[i].pending.insn;
-            const uint64_t* at = tps[i].reg_ready.data();
-            const uint64_t operands_at =
+            const uint32_t* at = tps[i].reg_ready.data();
+            const uint32_t operands_at =
                 std::max(std::max(at[d.rs1], at[d.rs2]), std::max(at[d.rs3], at[d.rd]));
-            const uint64_t bit = uint64_t{operands_at <= now} << (i & 63);
+            const uint64_t bit = uint64_t{operands_at <= now_offset} << (i & 63);
             ready |= bit;
             asking[size_t(tps[i].pending_pool)] |= bit & ~port_taken;  // no branch either way
         });
@@ -1019,15 +1033,16 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             Tm::Tp& tp = tps[i];
             const isa::Decoded& d = *tp.pending.insn;
             const std::array<uint8_t, 4> regs = {d.rs1, d.rs2, d.rs3, d.rd};
-            uint64_t operands_at = 0;
+            uint32_t last_ready = 0;
             for (uint8_t r : regs)
-                operands_at = std::max(operands_at, tp.reg_ready[r]);
+                last_ready = std::max(last_ready, tp.reg_ready[r]);
             Pool blocking = Pool::IntAlu;  // producer of the first operand that is ready last
             for (uint8_t r : regs)
-                if (r != isa::kNoReg && tp.reg_ready[r] == operands_at) {
+                if (r != isa::kNoReg && tp.reg_ready[r] == last_ready) {
                     blocking = tp.reg_producer[r];
                     break;
                 }
+            const uint64_t operands_at = tm.epoch.cycle(last_ready);
             ++counters.stalls[size_t(Stall::Operand)];
             ++counters.operand_stalls[size_t(blocking)];
             if constexpr (kProfile)
@@ -1116,7 +1131,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
                 result_at = kNever;  // set by the L1 reply
             }
             if (d.rd != isa::kNoReg && !s.mem_store) {
-                tp.reg_ready[d.rd] = result_at;
+                tp.reg_ready[d.rd] = tm.epoch.offset(result_at);
                 tp.reg_producer[d.rd] = pool;
             }
             if (s.exited) {

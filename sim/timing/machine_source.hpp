@@ -53,33 +53,34 @@ inline std::unique_ptr<core::Machine> make_machine(const core::Program& program,
 class MachineSource final : public InstructionSource {
 public:
     explicit MachineSource(core::Machine& machine)
-        : machine_(machine), ahead_(machine.thread_count()),
-          next_pcs_((machine.thread_count() + kPcsPerLine - 1) / kPcsPerLine) {
+        : machine_(machine), records_(machine.thread_count()), faults_(machine.thread_count()),
+          cursor_lines_((machine.thread_count() + kCursorsPerLine - 1) / kCursorsPerLine) {
         for (uint32_t t = 0; t < machine.thread_count(); ++t)
-            next_pc_of(t) = machine.next_pc(t);
+            cursor(t).pc = machine.next_pc(t);
     }
 
     core::Machine& machine() const { return machine_; }
 
     uint32_t next_pc(uint32_t thread) const override {
-        return next_pcs_[thread / kPcsPerLine].pc[thread % kPcsPerLine];
+        return cursor_lines_[thread / kCursorsPerLine].cursors[thread % kCursorsPerLine].pc;
     }
 
     /// Records run ahead are private (executed already); so is the next instruction if the
     /// machine says so. A fault waiting for its fetch is not: it must be raised in turn.
     bool next_is_private(uint32_t thread) const override {
-        const Ahead& a = ahead_[thread];
-        return a.next < a.size || (!a.fault && machine_.next_is_private(thread));
+        const Cursor& c = cursor(thread);
+        return c.next < c.size || (!faults_[thread] && machine_.next_is_private(thread));
     }
 
     void step(uint32_t thread, StepInfo& out) override {
-        Ahead& a = ahead_[thread];
-        if (a.next == a.size) {
-            if (a.fault) std::rethrow_exception(std::exchange(a.fault, nullptr));
-            run_ahead(thread, a);
-        }
-        out = a.records[a.next++];
-        next_pc_of(thread) = a.next < a.size ? a.records[a.next].pc : machine_.next_pc(thread);
+        Cursor& c = cursor(thread);
+        Records& records = records_[thread];
+        if (c.next == c.size) run_ahead(thread, c, records);
+        out = records[c.next++];
+        // The chip takes a thread's records one at a time, among those of a thousand other
+        // threads on large chips: the buffer's next line is fetched before it is needed.
+        __builtin_prefetch(&records[std::min<uint32_t>(c.next + kPrefetchAhead, kAhead - 1)]);
+        c.pc = c.next < c.size ? records[c.next].pc : machine_.next_pc(thread);
     }
 
     /// Functional warming (Chip::warm): thread `thread` executes up to `budget` instructions,
@@ -89,21 +90,22 @@ public:
     template <class Observer>
     bool warm(uint32_t thread, uint64_t budget, uint64_t& executed, StepInfo& last,
               Observer& observer) {
-        Ahead& a = ahead_[thread];
+        Cursor& c = cursor(thread);
+        const Records& records = records_[thread];
         executed = 0;
         bool stopped = false;
-        while (a.next < a.size && executed < budget && !stopped) {
-            const StepInfo& s = a.records[a.next++];
+        while (c.next < c.size && executed < budget && !stopped) {
+            const StepInfo& s = records[c.next++];
             ++executed;
             stopped = replay(s, last, observer);
         }
         if (executed < budget && !stopped) {
-            if (a.fault) std::rethrow_exception(std::exchange(a.fault, nullptr));
+            raise_fault_due(thread);
             uint64_t more = 0;
             stopped = machine_.run_observed(thread, budget - executed, more, last, observer);
             executed += more;
         }
-        next_pc_of(thread) = a.next < a.size ? a.records[a.next].pc : machine_.next_pc(thread);
+        c.pc = c.next < c.size ? records[c.next].pc : machine_.next_pc(thread);
         return stopped;
     }
 
@@ -124,38 +126,56 @@ public:
 
 private:
     static constexpr uint32_t kAhead = 128;  // records buffered per thread
+    static constexpr uint32_t kPrefetchAhead = 4;
     // Each thread's on its own cache lines (as are the machine's threads): the threads of TMs
     // simulated on different host threads must not share a line that both write.
-    struct alignas(64) Ahead {
-        std::array<StepInfo, kAhead> records;
-        uint32_t next = 0, size = 0;
-        // A fault of an instruction run ahead, raised when the chip fetches that instruction.
-        std::exception_ptr fault;
+    using Records = std::array<StepInfo, kAhead>;
+    static_assert(sizeof(Records) % 64 == 0);
+    struct alignas(64) AlignedRecords : Records {};
+    // What the chip reads of a thread at every fetch, dense: the pc it fetches next and its
+    // place in its records (records[next, size) are run ahead, not yet taken).
+    struct Cursor {
+        uint32_t pc = 0;
+        uint16_t next = 0, size = 0;
+    };
+    static_assert(kAhead <= UINT16_MAX);
+    // In whole cache lines: TMs of a multiple of 8 threads (32 by default) never share one.
+    static constexpr uint32_t kCursorsPerLine = 8;
+    struct alignas(64) CursorLine {
+        std::array<Cursor, kCursorsPerLine> cursors{};
     };
 
-    void run_ahead(uint32_t thread, Ahead& a) {
-        a.next = 0;
+    Cursor& cursor(uint32_t thread) {
+        return cursor_lines_[thread / kCursorsPerLine].cursors[thread % kCursorsPerLine];
+    }
+    const Cursor& cursor(uint32_t thread) const {
+        return cursor_lines_[thread / kCursorsPerLine].cursors[thread % kCursorsPerLine];
+    }
+
+    /// A fault of an instruction run ahead is raised when the chip comes to that instruction.
+    void raise_fault_due(uint32_t thread) {
+        if (faults_[thread]) std::rethrow_exception(std::exchange(faults_[thread], nullptr));
+    }
+
+    void run_ahead(uint32_t thread, Cursor& c, Records& records) {
+        raise_fault_due(thread);
+        uint32_t size = 0;
         try {
-            machine_.run_ahead(thread, a.records.data(), kAhead, a.size);
+            machine_.run_ahead(thread, records.data(), kAhead, size);
         } catch (...) {
-            if (a.size == 0) throw;  // the fetched instruction itself: its fault is due now
+            c.next = c.size = 0;
+            if (size == 0) throw;  // the fetched instruction itself: its fault is due now
             // A later one's: raised when the chip fetches it (its pc stays the thread's pc).
-            a.fault = std::current_exception();
+            faults_[thread] = std::current_exception();
         }
+        c.next = 0;
+        c.size = uint16_t(size);
     }
 
     core::Machine& machine_;
-    std::vector<Ahead> ahead_;
-    // Per thread, dense (the chip asks every fetch cycle), in whole cache lines: TMs of a
-    // multiple of 16 threads (32 by default) never share one.
-    static constexpr uint32_t kPcsPerLine = 16;
-    struct alignas(64) PcLine {
-        std::array<uint32_t, kPcsPerLine> pc{};
-    };
-    std::vector<PcLine> next_pcs_;
-    uint32_t& next_pc_of(uint32_t thread) {
-        return next_pcs_[thread / kPcsPerLine].pc[thread % kPcsPerLine];
-    }
+    std::vector<AlignedRecords> records_;
+    std::vector<std::exception_ptr> faults_;
+    std::vector<CursorLine> cursor_lines_;
 };
 
 }  // namespace tpsim::timing
