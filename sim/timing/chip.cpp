@@ -1298,31 +1298,42 @@ void Chip::register_stats(stats::Registry& r) const {
     r.add_level("chip/local_store_high_water", local_store_high_water_,
                 "largest local-store (stack) footprint of any thread", "B");
 
-    // Traffic by region (docs/statistics.md says how each figure is counted).
+    // Traffic by region (docs/statistics.md says how each figure is counted): one level's
+    // counters, worded for what the region carries (data, or instruction lines, never written).
+    struct Carried {
+        std::string_view requests, each, payload;
+        bool written;
+    };
+    const Carried data{"loads", "loads", "bytes the kernel's loads and stores asked of this level",
+                       true};
+    const Carried instructions{"I-cache line requests", "line requests",
+                               "bytes of instruction lines asked of this level", false};
+    const auto add_traffic = [&](std::string_view region, std::string_view level,
+                                 const LevelTraffic& t, bool cache, const Carried& c) {
+        const std::string p = fmt::format("region/{}/{}/", region, level);
+        r.add_counter(p + "reads", t.reads,
+                      cache ? fmt::format("{} accepted", c.requests) : "line reads served",
+                      "accesses");
+        if (c.written)
+            r.add_counter(p + "writes", t.writes, cache ? "stores accepted" : "line writes served",
+                          "accesses");
+        if (cache) {
+            r.add_counter(p + "hits", t.hits, fmt::format("{} that hit", c.each), "accesses");
+            r.add_counter(p + "misses", t.misses,
+                          fmt::format("{} that requested a line below", c.each), "accesses");
+            r.add_counter(p + "merged_misses", t.merged_misses,
+                          fmt::format("{} merged into an outstanding miss", c.each), "accesses");
+        }
+        r.add_counter(p + "payload_bytes", t.payload_bytes, std::string(c.payload), "B");
+        r.add_counter(p + "moved_bytes", t.moved_bytes,
+                      "bytes this level moved to or from the level below", "B");
+    };
     for (size_t region = 0; region <= layout_.regions.size(); ++region) {
         const std::string& name =
             region < layout_.regions.size() ? layout_.regions[region].name : "other";
-        const auto add = [&](std::string_view level, const LevelTraffic& t, bool cache) {
-            const std::string p = fmt::format("region/{}/{}/", name, level);
-            r.add_counter(p + "reads", t.reads, cache ? "loads accepted" : "line reads served",
-                          "accesses");
-            r.add_counter(p + "writes", t.writes, cache ? "stores accepted" : "line writes served",
-                          "accesses");
-            if (cache) {
-                r.add_counter(p + "hits", t.hits, "loads that hit", "accesses");
-                r.add_counter(p + "misses", t.misses, "loads that requested a line below",
-                              "accesses");
-                r.add_counter(p + "merged_misses", t.merged_misses,
-                              "loads merged into an outstanding miss", "accesses");
-            }
-            r.add_counter(p + "payload_bytes", t.payload_bytes,
-                          "bytes the kernel's loads and stores asked of this level", "B");
-            r.add_counter(p + "moved_bytes", t.moved_bytes,
-                          "bytes this level moved to or from the level below", "B");
-        };
-        add("l1", l1_traffic_[region], true);
-        add("l2", l2_traffic_[region], true);
-        add("dram", dram_traffic_[region], false);
+        add_traffic(name, "l1", l1_traffic_[region], true, data);
+        add_traffic(name, "l2", l2_traffic_[region], true, data);
+        add_traffic(name, "dram", dram_traffic_[region], false, data);
     }
     r.add_sum("region/local_store/local_store/loads", "*/local_store/loads",
               "loads served by the local stores", "accesses");
@@ -1334,24 +1345,8 @@ void Chip::register_stats(stats::Registry& r) const {
               "instructions fetched, all TMs", "instructions");
     if (!finite_icache) return;
     // After the region's sum of */icache/fetches, which chip/icache/fetches would join.
-    const auto add_fetch_traffic = [&](std::string_view level, const LevelTraffic& t, bool cache) {
-        const std::string p = fmt::format("region/instruction_fetch/{}/", level);
-        r.add_counter(p + "reads", t.reads,
-                      cache ? "I-cache line requests accepted" : "line reads served", "accesses");
-        if (cache) {
-            r.add_counter(p + "hits", t.hits, "line requests that hit", "accesses");
-            r.add_counter(p + "misses", t.misses, "line requests that requested a line below",
-                          "accesses");
-            r.add_counter(p + "merged_misses", t.merged_misses,
-                          "line requests merged into an outstanding miss", "accesses");
-        }
-        r.add_counter(p + "payload_bytes", t.payload_bytes,
-                      "bytes of instruction lines asked of this level", "B");
-        r.add_counter(p + "moved_bytes", t.moved_bytes,
-                      "bytes this level moved to or from the level below", "B");
-    };
-    add_fetch_traffic("l2", l2_traffic_[fetch_region_], true);
-    add_fetch_traffic("dram", dram_traffic_[fetch_region_], false);
+    add_traffic("instruction_fetch", "l2", l2_traffic_[fetch_region_], true, instructions);
+    add_traffic("instruction_fetch", "dram", dram_traffic_[fetch_region_], false, instructions);
     r.add_sum("chip/icache/fetches", "*/icache/fetches",
               "fetches granted by the banks (lookups), all TMs", "fetches");
     for (std::string_view leaf : {"misses", "merged_misses", "mshr_full", "evictions"})

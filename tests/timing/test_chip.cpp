@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include "tests/timing/documented_stats.hpp"
+#include "tests/timing/small_chips.hpp"
 
 #include <algorithm>
 #include <deque>
@@ -61,14 +62,6 @@ private:
     std::vector<std::vector<StepInfo>> trace_;
     std::vector<size_t> next_;
 };
-
-ChipConfig one_tp() {
-    ChipConfig c;
-    c.chip.num_tms = 1;
-    c.chip.tps_per_tm = 1;
-    c.chip.tms_per_l2 = 1;
-    return c;
-}
 
 uint64_t stat(const stats::Registry& r, std::string_view name) {
     return r.at(name).integer();

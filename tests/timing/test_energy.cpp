@@ -8,6 +8,7 @@
 
 #include "sim/core/elf_loader.hpp"
 #include "sim/timing/machine_source.hpp"
+#include "tests/timing/small_chips.hpp"
 
 #include <cmath>
 #include <memory>
@@ -44,14 +45,6 @@ struct ChainRun {
     }
     double value(std::string_view name) const { return stats.value(name); }
 };
-
-ChipConfig one_tp() {
-    ChipConfig c;
-    c.chip.num_tms = 1;
-    c.chip.tps_per_tm = 1;
-    c.chip.tms_per_l2 = 1;
-    return c;
-}
 
 }  // namespace
 
