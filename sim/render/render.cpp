@@ -174,11 +174,15 @@ RenderResult render(const RenderOptions& options) {
                 profile_of(result.timing->chip->profile(), kernel.program));
         result.instructions = result.timing->instructions;
         result.output = result.timing->machine->output();
+        result.host_threads = result.timing->host_threads;
+        result.host_threads_share = result.timing->host_threads_share;
     } else {
         KernelRun run = run_kernel(kernel, options.engine, result.image, options.chip,
                                    options.max_instructions, item_limit, options.twin_process);
         result.instructions = run.instructions;
         result.output = std::move(run.output);
+        if (options.engine == Engine::functional && core::host_threads_set())
+            result.host_threads = std::min(core::host_threads(), result.threads);
     }
     result.run_seconds = seconds_since(start);
     result.run_cpu_seconds = process_cpu_seconds() - cpu_start;

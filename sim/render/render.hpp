@@ -130,6 +130,10 @@ struct RenderResult {
     std::shared_ptr<const TimingRun> timing;  ///< Engine::timing: the chip and its counters
     std::shared_ptr<const Profile> profile;   ///< RenderOptions::profile: by function and line
     double load_seconds = 0, bvh_seconds = 0, run_seconds = 0;  ///< host wall clock
+    /// The host threads the kernel run used: at most `host_threads`, for this share of its
+    /// instructions (the rest on one; TimingRun).
+    uint32_t host_threads = 1;
+    double host_threads_share = 1;
     /// Host CPU time of the kernel run (process CPU time around it): the simulator's cost,
     /// which the machine's load disturbs much less than wall time (tpsim sample-check); it
     /// does not see the native twin's child process.

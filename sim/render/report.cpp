@@ -50,6 +50,15 @@ std::string percent_text(double numerator, double denominator) {
     return denominator > 0 ? fmt::format("{:.1f}%", 100 * numerator / denominator) : "-";
 }
 
+/// "1 host thread", "2 host threads", "1-2 host threads (2 for 64 % of the instructions)".
+std::string host_threads_text(const RenderResult& r) {
+    const uint32_t n = r.host_threads;
+    if (n == 1) return "1 host thread";
+    if (r.host_threads_share >= 1) return fmt::format("{} host threads", n);
+    return fmt::format("1-{} host threads ({} for {:.0f} % of the instructions)", n, n,
+                       100 * r.host_threads_share);
+}
+
 bool has_value(const stats::Snapshot& snapshot, std::string_view name) {
     return std::any_of(snapshot.values().begin(), snapshot.values().end(),
                        [&](const stats::Value& v) { return v.name == name; });
@@ -262,11 +271,18 @@ void register_stats(const RenderResult& r, stats::Registry& reg) {
         "host/load_seconds", [&r] { return r.load_seconds; }, "scene load and import time", "s");
     number(
         "host/run_seconds", [&r] { return r.run_seconds; }, "kernel run time on the host", "s");
-    if (r.instructions.total > 0)
+    if (r.instructions.total > 0) {
         number(
             "host/simulated_instructions_per_second",
             [&r] { return r.run_seconds > 0 ? double(r.instructions.total) / r.run_seconds : 0.0; },
             "simulation speed", "instr/s");
+        number(
+            "host/threads", [&r] { return double(r.host_threads); },
+            "most host threads the kernel run used", "threads");
+        number(
+            "host/threads_share", [&r] { return r.host_threads_share; },
+            "share of the instructions simulated on host/threads threads (the rest on one)");
+    }
 }
 
 RunStatistics run_statistics(const RenderResult& result) {
@@ -416,9 +432,10 @@ void print_summary(const RenderOptions& options, const RenderResult& r,
     }
     if (r.instructions.total > 0)
         fmt::print(out,
-                   "run      {} instructions in {:.3f} s = {:.1f} M simulated instructions/s\n",
+                   "run      {} instructions in {:.3f} s = {:.1f} M simulated instructions/s on "
+                   "{}\n",
                    r.instructions.total, r.run_seconds,
-                   double(r.instructions.total) / r.run_seconds / 1e6);
+                   double(r.instructions.total) / r.run_seconds / 1e6, host_threads_text(r));
     else
         fmt::print(out, "run      {:.3f} s\n", r.run_seconds);
     if (statistics.estimate) print_sampling(r, *statistics.estimate, out);

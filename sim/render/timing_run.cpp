@@ -28,10 +28,14 @@ std::shared_ptr<TimingRun> run_timing(const core::Program& program, image::Memor
     // --threads unset: sampled runs stay on one host thread (their units of a few thousand
     // cycles are too short to share), full runs choose as they go.
     std::optional<core::HostThreadChoice> choice;
-    if (core::host_threads_set())
+    // At most one host thread per TM (Chip::use_host_threads).
+    const uint32_t most = std::min(core::host_threads(), chip.chip.num_tms);
+    if (core::host_threads_set()) {
         model.use_host_threads(core::host_threads());
-    else if (!options.sampling)
+        run->host_threads = most;
+    } else if (!options.sampling) {
         choice.emplace(core::host_threads());
+    }
     stats::Registry chip_stats;
     model.register_stats(chip_stats);
     const auto report = [&] {
@@ -64,15 +68,18 @@ std::shared_ptr<TimingRun> run_timing(const core::Program& program, image::Memor
     // past the end before they stop, hence the cap.
     constexpr uint64_t kInterval = timing::Chip::kProgressInterval;
     uint64_t next_report = kInterval;
+    uint64_t on_most = 0;  // instructions simulated on `most` host threads, as chosen
     const auto run_chunk = [&](uint64_t until) {
         if (!choice) return model.run_until(until);
-        model.use_host_threads(choice->next());
+        const uint32_t threads = choice->next();
+        model.use_host_threads(threads);
         const uint64_t before = machine.counters().instructions;
         const auto start = std::chrono::steady_clock::now();
         const bool finished = model.run_until(until);
+        const uint64_t work = machine.counters().instructions - before;
         choice->ran(
-            machine.counters().instructions - before,
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+            work, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        if (threads > 1) on_most += work;
         return finished;
     };
     while (!run_chunk(std::min(next_report, timeline.next_sample()))) {
@@ -86,6 +93,10 @@ std::shared_ptr<TimingRun> run_timing(const core::Program& program, image::Memor
     std::memcpy(image.words.data(), machine.memory().global().data(), image.bytes());
 
     run->instructions = InstructionCounts::of(machine.counters());
+    if (choice && on_most != 0) {
+        run->host_threads = most;
+        run->host_threads_share = double(on_most) / double(run->instructions.total);
+    }
     return run;
 }
 

@@ -26,6 +26,10 @@ struct TimingRun {
     timing::ChipConfig config;  ///< the chip's configuration, for the energy and area estimate
     std::unique_ptr<Timeline> timeline;  ///< none for a sampled run
     InstructionCounts instructions;
+    /// The host threads it ran on: at most `host_threads`, for this share of its instructions
+    /// (with --threads unset a run chooses between one and all cores as it goes).
+    uint32_t host_threads = 1;
+    double host_threads_share = 1;
     /// A sampled run: what it did, and what it measured for stats::estimate().
     std::optional<SamplingSummary> sampling;
     stats::UnitSamples samples;
