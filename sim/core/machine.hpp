@@ -11,6 +11,7 @@
 #include "kernel/memory_map.hpp"
 #include "sim/core/elf_loader.hpp"
 #include "sim/core/fault.hpp"
+#include "sim/core/host_spacing.hpp"
 #include "sim/core/memory.hpp"
 
 namespace tpsim::core {
@@ -265,7 +266,7 @@ private:
     /// The counters of the threads of TM t in counter_lanes_[t] (t = thread / threads_per_tm),
     /// each on its own cache lines: TMs simulated on different host threads never write the
     /// same counters.
-    struct alignas(64) CounterLane {
+    struct alignas(kHostSpacing) CounterLane {
         Counters counters;
     };
     std::vector<CounterLane> counter_lanes_;

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <memory>
 
+#include "sim/core/host_spacing.hpp"
 #include "sim/core/spin_wait.hpp"
 
 namespace tpsim::core {
@@ -30,6 +31,10 @@ public:
     void reach(uint32_t lane, uint64_t position) {
         at_[lane].value.store(position, std::memory_order_release);
     }
+    /// The position lane `lane` reached last (read by that lane).
+    uint64_t position(uint32_t lane) const {
+        return at_[lane].value.load(std::memory_order_relaxed);
+    }
     /// Returns once every other lane has reached a position after `position`.
     void wait_turn(uint32_t lane, uint64_t position) const {
         for (uint32_t other = 0; other < lanes_; ++other) {
@@ -41,7 +46,7 @@ public:
     }
 
 private:
-    struct alignas(64) Position {  // own cache line: lanes write theirs at every step
+    struct alignas(kHostSpacing) Position {  // lanes write theirs at every step
         std::atomic<uint64_t> value{0};
     };
     uint32_t lanes_, spins_;

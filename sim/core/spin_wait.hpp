@@ -4,6 +4,8 @@
 // window's work. So a waiter spins, with the CPU's pause hint, and only after a while yields
 // its core on every try (on a busy host the thread it waits for may need that core).
 #pragma once
+#include "sim/core/host_spacing.hpp"
+
 #include <atomic>
 #include <cstdint>
 #include <thread>
@@ -59,14 +61,6 @@ public:
         : spins_(spins_for(count)), completion_(std::move(completion)), count_(count) {}
 
     void arrive_and_wait() { arrive(false); }
-    /// Arrives as the one thread that always runs the completion, once all the others have
-    /// arrived: what the completion touches stays in that thread's core's caches.
-    void lead() {
-        const uint32_t phase = phase_.load(std::memory_order_acquire);
-        const uint32_t count = count_.load(std::memory_order_relaxed);
-        spin_until([&] { return arrived_.load(std::memory_order_acquire) + 1 == count; }, spins_);
-        complete(phase, count);
-    }
     /// Arrives without waiting, and leaves: later phases wait for one thread fewer.
     void arrive_and_drop() { arrive(true); }
 
@@ -100,9 +94,9 @@ private:
     const uint32_t spins_;
     Completion completion_;
     // Own cache lines: every arrival writes the first, every waiter reads the second.
-    alignas(64) std::atomic<uint32_t> arrived_{0};
+    alignas(kHostSpacing) std::atomic<uint32_t> arrived_{0};
     std::atomic<uint32_t> dropping_{0};
-    alignas(64) std::atomic<uint32_t> phase_{0};
+    alignas(kHostSpacing) std::atomic<uint32_t> phase_{0};
     std::atomic<uint32_t> count_;
 };
 

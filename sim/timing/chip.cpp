@@ -14,6 +14,8 @@
 #include <atomic>
 #include <bit>
 #include <functional>
+#include <iterator>
+#include <mutex>
 #include <stdexcept>
 #include <thread>
 #include <utility>
@@ -64,13 +66,26 @@ void count_access(LevelTraffic& t, CacheOutcome outcome, uint64_t payload, uint6
     }
 }
 
+/// Moves every element of `from` to the back of `to`, in order.
+template <class Queue> void move_to_back(Queue& to, Queue& from) {
+    to.insert(to.end(), std::make_move_iterator(from.begin()), std::make_move_iterator(from.end()));
+    from.clear();
+}
+
+/// Lowers `count` to `to` if it is above (several host threads may).
+void lower(std::atomic<uint64_t>& count, uint64_t to) {
+    uint64_t now = count.load();
+    while (to < now && !count.compare_exchange_weak(now, to)) {
+    }
+}
+
 /// Region names that the chip's own region/ keys use.
 constexpr std::string_view kReservedRegions[] = {"other", "local_store", "instruction_fetch"};
 
 }  // namespace
 
 // On its own cache lines: TMs ticked on different host threads never share one.
-struct alignas(64) Chip::Tm {
+struct alignas(core::kHostSpacing) Chip::Tm {
     // Per-TP flags the cycle loop tests for many TPs at once are bit sets over the TPs (bit
     // i of word i / 64); the rest of a TP's state is in Tp.
     using TpBits = std::vector<uint64_t>;
@@ -178,6 +193,36 @@ struct alignas(64) Chip::Tm {
             ++progress;
         }
     }
+    /// Before the TM's ticks of a stretch of cycles, on the host thread that ticks it: the
+    /// fills and replies delivered to it so far.
+    void take_mail() {
+        if (!inbox.holds_mail.load(std::memory_order_acquire)) return;
+        std::lock_guard hold(inbox.lock);
+        move_to_back(fills, inbox.fills);
+        move_to_back(replies, inbox.replies);
+        inbox.holds_mail.store(false, std::memory_order_relaxed);
+    }
+    /// After the TM's ticks of a stretch of cycles, on the host thread that ticked it: what it
+    /// sent to the shared parts, its work-item charges and its progress.
+    void hand_over() {
+        std::deque<OutboundRequest>& sent = l1.outbound();
+        if (sent.empty() && atomics_out.empty() && charges.empty() && first_progress == kNever)
+            return;
+        std::lock_guard hold(outbox.lock);
+        move_to_back(outbox.requests, sent);
+        move_to_back(outbox.atomics, atomics_out);
+        outbox.charges.insert(outbox.charges.end(), charges.begin(), charges.end());
+        charges.clear();
+        outbox.first_progress =
+            std::min(outbox.first_progress, std::exchange(first_progress, kNever));
+        outbox.last_progress = std::max(outbox.last_progress, std::exchange(last_progress, 0));
+    }
+    /// Any memory or global-register traffic of this TM in flight (an idle TM: one whose
+    /// threads have all exited, ticked by the shared parts' host thread only).
+    bool holds_traffic() const {
+        return l1.outstanding_misses() || !l1.outbound().empty() || !outbox.requests.empty() ||
+               !at_shared.requests.empty() || !replies.empty() || !inbox.replies.empty();
+    }
     /// Start of cycle `now`: L2 fills, global-register replies, then the L1's and the finite
     /// I-cache's replies.
     void receive(uint64_t now) {
@@ -233,6 +278,7 @@ struct alignas(64) Chip::Tm {
     }
 
     uint32_t id;
+    uint32_t lane = 0;  // the host thread that ticks it (Chip::first_tm)
     uint32_t words;     // 64-bit words of a TpBits
     EpochCycles epoch;  // of the TPs' scoreboards
     std::vector<Tp> tps;
@@ -246,10 +292,8 @@ struct alignas(64) Chip::Tm {
     // after it was sent.
     std::deque<AtomicRequest> atomics_out;
     uint32_t running = 0;
-    uint64_t idle_from = kNever;  // first cycle with every thread exited
-    // Delivered before each window (Chip::deliver), received in the cycle they arrive: L2
-    // fills of L1 (or I-cache) lines and global-register replies, each in the order the shared
-    // parts produced them.
+    // Received in the cycle they arrive: L2 fills of L1 (or I-cache) lines and global-register
+    // replies, each in the order the shared parts produced them (from the inbox).
     static constexpr uint32_t kDataLine = UINT32_MAX;
     struct Fill {
         uint64_t cycle;
@@ -258,16 +302,42 @@ struct alignas(64) Chip::Tm {
     };
     std::deque<Fill> fills;
     std::deque<AtomicReply> replies;
-    // Work-item charges made in a window, added to the chip's costs after it.
+    // Work-item charges made in a stretch of cycles, added to the chip's costs after it.
     struct ItemCharge {
         uint32_t item;
         uint64_t cycles, instructions;
     };
     std::vector<ItemCharge> charges;
-    // Deadlock detector: events (issues, replies) so far, and the window's first and last
+    // Deadlock detector: events (issues, replies) so far, and the stretch's first and last
     // cycle with any.
     uint64_t progress = 0;
     uint64_t first_progress = kNever, last_progress = 0;
+    // What the shared parts' host thread reads of the TM while another host thread may tick it
+    // is on cache lines of its own, which the ticks do not write (docs/hardware-model.md,
+    // "Parallel simulation"). First the cycle with every thread exited: from then on the shared
+    // parts tick the TM (it only receives).
+    alignas(core::kHostSpacing) std::atomic<uint64_t> idle_from = kNever;
+    // Then a mailbox each way, each under its own lock.
+    struct alignas(
+        core::kHostSpacing) Outbox {  // filled by hand_over(), emptied by Chip::take_hand_overs
+        std::mutex lock;
+        std::deque<OutboundRequest> requests;  // to the L2: the L1's and I-cache's, FIFO
+        std::deque<AtomicRequest> atomics;     // to the global-register unit
+        std::vector<ItemCharge> charges;
+        uint64_t first_progress = kNever, last_progress = 0;
+    } outbox;
+    struct alignas(core::kHostSpacing) Inbox {  // filled by Chip::deliver, emptied by take_mail()
+        std::mutex lock;
+        std::atomic<bool> holds_mail{false};
+        std::deque<Fill> fills;
+        std::deque<AtomicReply> replies;
+    } inbox;
+    // The TM's requests once the shared parts have taken them, until the L2 or the
+    // global-register unit accepts each (the shared parts' own).
+    struct alignas(core::kHostSpacing) AtShared {
+        std::deque<OutboundRequest> requests;
+        std::deque<AtomicRequest> atomics;
+    } at_shared;
     // Visited by the cycle loop: not exited, not asleep (timed sleepers wait in the wheel,
     // reply-waits return through wake()).
     TpBits awake_tps;
@@ -352,9 +422,10 @@ Chip::Chip(const ChipConfig& config, InstructionSource& source, const ChipLayout
     use_host_threads(1);
 }
 
-/// The TMs' host threads: lane 0 is the calling thread, lanes 1.. wait for work between windows.
+/// The TMs' host threads: lane 0 is the calling thread, lanes 1.. wait for work between runs.
 struct Chip::HostThreads {
-    explicit HostThreads(uint32_t lanes) : turns(lanes), start(lanes), done(lanes) {
+    explicit HostThreads(uint32_t lanes)
+        : turns(lanes), ticked(new Count[lanes]), start(lanes), done(lanes) {
         for (uint32_t lane = 1; lane < lanes; ++lane)
             threads.emplace_back([this, lane] {
                 for (;;) {
@@ -372,13 +443,13 @@ struct Chip::HostThreads {
             t.join();
     }
     /// Runs job(lane) on every lane and returns when all are done; `job` must not throw.
-    /// Between its windows, job calls window_done.arrive_and_wait(), which runs `between`.
     void run(const std::function<void(uint32_t)>& work) {
         job = &work;
         start.arrive_and_wait();
         work(0);
         done.arrive_and_wait();
     }
+    uint32_t lanes() const { return turns.lanes(); }
 
     core::OrderedTurns turns;
     // A lane that failed: where in the order, and what (the earliest is rethrown).
@@ -388,14 +459,18 @@ struct Chip::HostThreads {
     };
     std::vector<Failure> failures = std::vector<Failure>(turns.lanes());
     std::atomic<uint64_t> first_failure{core::OrderedTurns::kDone};
+    // The pipeline of a run (Chip::run_pipelined), counted in stretches of cycles from its
+    // start: how many each lane has ticked its TMs through, how many the shared parts have
+    // run, and how many of each may run at all (fewer once the chip has finished or
+    // something has failed).
+    struct alignas(core::kHostSpacing) Count {  // one lane writes it, the others read it
+        std::atomic<uint64_t> value{0};
+    };
+    std::unique_ptr<Count[]> ticked;
+    Count shared;
+    Count lane_limit, shared_limit;
     // Between runs the lanes sleep (after a short spin: runs follow each other closely).
     core::SpinBarrier<> start, done;
-    std::function<void()> between;  // must not throw
-    struct Between {
-        HostThreads* host;
-        void operator()() noexcept { host->between(); }
-    };
-    core::SpinBarrier<Between> window_done{turns.lanes(), Between{this}};
     bool stop = false;
     const std::function<void(uint32_t)>* job = nullptr;
     std::vector<std::thread> threads;
@@ -414,11 +489,14 @@ void Chip::use_host_threads(uint32_t threads) {
         lane.profile.words.resize(profile_.words.size());
     }
     if (!profile_lanes_.empty()) profile_lanes_[0].profile.words = profile_.words;
-    for (auto& tm : tms_)
-        if (layout_.profile) {
-            ProfileLane& lane = profile_lanes_[tm->id % lanes];
-            tm->profile = &lane.profile;
-            tm->outside_text = &lane.outside_text;
+    for (uint32_t lane = 0; lane < lanes; ++lane)
+        for (uint32_t t = first_tm(lane, lanes); t < first_tm(lane + 1, lanes); ++t) {
+            Tm& tm = *tms_[t];
+            tm.lane = lane;
+            if (layout_.profile) {
+                tm.profile = &profile_lanes_[lane].profile;
+                tm.outside_text = &profile_lanes_[lane].outside_text;
+            }
         }
 }
 
@@ -449,8 +527,8 @@ bool Chip::quiescent() const {
         // flight.
         for (const Tm::Tp& tp : tm->tps)
             if (tp.wake_at == kNever || tp.wake_at == kFetchWait) return false;
-        if (tm->l1.outstanding_misses() || !tm->l1.outbound().empty() || !tm->atomics_out.empty() ||
-            !tm->replies.empty())
+        if (tm->holds_traffic() || !tm->atomics_out.empty() || !tm->outbox.atomics.empty() ||
+            !tm->at_shared.atomics.empty())
             return false;
     }
     for (const Cache& l2 : l2s_)
@@ -597,11 +675,10 @@ uint64_t Chip::run(uint64_t max_cycles) {
 }
 
 bool Chip::busy(uint64_t at) const {
+    // A TM still running may be ticking on another host thread: only its idle_from is read.
     // A global-register reply delivered to a TM but not received yet is still in flight.
     for (const auto& tm : tms_)
-        if (tm->idle_from > at || tm->l1.outstanding_misses() || !tm->l1.outbound().empty() ||
-            !tm->replies.empty())
-            return true;
+        if (tm->idle_from.load(std::memory_order_relaxed) > at || tm->holds_traffic()) return true;
     for (const Cache& l2 : l2s_)
         if (l2.outstanding_misses() || !l2.outbound().empty()) return true;
     return !dram_.idle() || !global_registers_.idle();
@@ -653,25 +730,22 @@ void Chip::collect() {
     }
 }
 
-// A window of cycles at a time: the TMs' ticks (on the host threads), then the shared parts'
-// ticks of the same cycles (docs/hardware-model.md, "Parallel simulation").
+// Stretches of cycles: the TMs' ticks (on the host threads), then the shared parts' ticks of
+// the same cycles (docs/hardware-model.md, "Parallel simulation").
 template <class Source> bool Chip::run_cycles(uint64_t end) {
     // The constructor chose Source to be the source's own type.
     Source& source = static_cast<Source&>(source_);
-    // A short stretch (drain() runs one cycle at a time) is not worth waking the host threads;
+    // A short run (drain() runs one cycle at a time) is not worth waking the host threads;
     // either way gives the same result.
     constexpr uint64_t kShortestParallelRun = 256;
-    if (host_threads_ && end >= cycles_ + kShortestParallelRun) {
-        run_windows_in_parallel(end, source);
+    if (host_threads_ && end >= cycles_ + kShortestParallelRun && !finished_) {
+        run_pipelined(end, source);
     } else {
         while (cycles_ < end && !finished_) {
             const uint64_t first = cycles_;
-            const uint64_t window_end = std::min(end, first + lookahead_);
-            deliver(window_end);
-            for (uint64_t now = first; now < window_end; ++now)
-                for (auto& tm : tms_)
-                    if (tm->running != 0) tm_cycle(*tm, now, source);
-            shared_window(first, window_end, source);
+            const uint64_t stretch_end = std::min(end, first + lookahead_);
+            tick_tms(0, 1, first, stretch_end, source);
+            shared_stretch(first, stretch_end, source);
         }
     }
     finished_ = finished_ || drained();
@@ -679,131 +753,204 @@ template <class Source> bool Chip::run_cycles(uint64_t end) {
     return finished_;
 }
 
-template <class Source> void Chip::run_windows_in_parallel(uint64_t end, Source& source) {
+template <class Source> void Chip::run_pipelined(uint64_t end, Source& source) {
     HostThreads& host = *host_threads_;
-    windows_in_parallel_ = true;
+    tms_in_parallel_ = true;
     struct Serial {
         bool& parallel;
         ~Serial() { parallel = false; }
-    } serial_after{windows_in_parallel_};
-    const uint32_t lanes = host.turns.lanes();
-    uint64_t first = cycles_, window_end = std::min(end, first + lookahead_);
-    bool more = cycles_ < end && !finished_;
-    if (more) deliver(window_end);
-    std::exception_ptr error;
-    // Between two windows, on one host thread while the others wait: the shared parts' share
-    // of the window just simulated, then the next window's deliveries.
-    host.between = [&] {
-        try {
-            if (host.first_failure != core::OrderedTurns::kDone) {
-                for (const HostThreads::Failure& failure : host.failures)
-                    if (failure.position == host.first_failure) error = failure.error;
-                more = false;
+    } serial_after{tms_in_parallel_};
+    const uint32_t lanes = host.lanes();
+    // Stretches of half the lookahead: the shared parts run stretch k - lag (on lane 0, after
+    // its TMs' share of stretch k) while the other lanes' TMs run stretch k or k + 1. What a TM
+    // receives in stretch k was decided a lookahead earlier, by stretch k - lag - 1 at the
+    // latest; so no lane waits for another unless one falls more than a stretch behind.
+    const uint64_t stretch = std::max<uint64_t>(lookahead_ / 2, 1);
+    const uint64_t lag = lookahead_ / stretch - 1;
+    const uint64_t first = cycles_;
+    const auto begin = [&](uint64_t k) { return first + k * stretch; };
+    const auto finish = [&](uint64_t k) { return std::min(end, begin(k) + stretch); };
+    const auto load = [](const HostThreads::Count& c) {
+        return c.value.load(std::memory_order_acquire);
+    };
+    for (uint32_t lane = 0; lane < lanes; ++lane)
+        host.ticked[lane].value = 0;
+    host.shared.value = 0;
+    host.lane_limit.value = host.shared_limit.value = kNever;
+    const uint32_t spins = core::spins_for(lanes);
+    std::exception_ptr shared_error;
+
+    const auto follow = [&](uint32_t lane) {
+        for (uint64_t k = 0; begin(k) < end; ++k) {
+            // Stretch k receives what the shared parts' stretch k - lag - 1 decided.
+            core::spin_until(
+                [&] { return load(host.shared) + lag >= k || k >= load(host.lane_limit); }, spins);
+            if (k >= load(host.lane_limit) || !tick_lane(lane, k, begin(k), finish(k), source))
                 return;
-            }
-            shared_window(first, window_end, source);
-            first = cycles_;
-            window_end = std::min(end, first + lookahead_);
-            more = cycles_ < end && !finished_;
-            if (more) deliver(window_end);
-        } catch (...) {
-            error = std::current_exception();
-            more = false;
+            host.ticked[lane].value.store(k + 1, std::memory_order_release);
         }
     };
-    host.run([&](uint32_t lane) {
-        while (more) {
-            tick_lane(lane, lanes, first, window_end, source);
-            if (lane == 0)
-                host.window_done.lead();
-            else
-                host.window_done.arrive_and_wait();
+    const auto lead = [&] {
+        bool ticking = true;
+        for (uint64_t k = 0;; ++k) {
+            ticking = ticking && begin(k) < end && k < load(host.lane_limit) &&
+                      tick_lane(0, k, begin(k), finish(k), source);
+            if (ticking) host.ticked[0].value.store(k + 1, std::memory_order_release);
+            const uint64_t s = k - lag;  // the shared parts' stretch, once k >= lag
+            if (k < lag) continue;
+            if (begin(s) >= end || s >= load(host.shared_limit)) {
+                if (!ticking) return;
+                continue;
+            }
+            for (uint32_t lane = 1; lane < lanes; ++lane)
+                core::spin_until(
+                    [&] { return load(host.ticked[lane]) > s || s >= load(host.shared_limit); },
+                    spins);
+            if (s >= load(host.shared_limit)) continue;
+            try {
+                shared_stretch(begin(s), finish(s), source);
+            } catch (...) {  // nothing from stretch s on counts: the lanes stop
+                shared_error = std::current_exception();
+                lower(host.lane_limit.value, s);
+                lower(host.shared_limit.value, s);
+                host.turns.reach(0, core::OrderedTurns::kDone);
+                return;
+            }
+            if (finished_) {  // the lanes' later stretches have only idle TMs: they stop
+                lower(host.lane_limit.value, s + 1);
+                lower(host.shared_limit.value, s + 1);
+            }
+            host.shared.value.store(s + 1, std::memory_order_release);
         }
-    });
-    if (error) std::rethrow_exception(error);
+    };
+    host.run([&](uint32_t lane) { lane == 0 ? lead() : follow(lane); });
+    if (shared_error) std::rethrow_exception(shared_error);
+    const uint64_t failed = host.first_failure.load();
+    for (const HostThreads::Failure& failure : host.failures)
+        if (failed != core::OrderedTurns::kDone && failure.position == failed)
+            std::rethrow_exception(failure.error);
 }
 
-template <class Source>
-void Chip::shared_window(uint64_t first, uint64_t window_end, Source& source) {
-    {
-        uint64_t first_progress = kNever, last_progress = 0;
-        for (auto& tm : tms_) {
-            for (const Tm::ItemCharge& c : tm->charges)
-                charge_item(c.item, c.cycles, c.instructions);
-            tm->charges.clear();
-            first_progress = std::min(first_progress, std::exchange(tm->first_progress, kNever));
-            last_progress = std::max(last_progress, std::exchange(tm->last_progress, 0));
-        }
-        shared_first_progress_ = kNever;
-        shared_last_progress_ = 0;
-        uint64_t now = first;
-        for (; now < window_end; ++now) {
-            if (!busy(now)) {
-                // Every thread has exited: the write-combining buffers drain, then the chip is
-                // done. (No TM has ticked this cycle: each stops when its last thread exits.)
-                bool drained_lines = false;
-                for (Cache& l2 : l2s_)
-                    drained_lines |= l2.drain_write_buffer(now);
-                if (!drained_lines) {
-                    finished_ = true;
-                    break;
-                }
+template <class Source> void Chip::shared_stretch(uint64_t first, uint64_t end, Source& source) {
+    uint64_t first_progress = kNever, last_progress = 0;
+    take_hand_overs(first_progress, last_progress);
+    // TMs whose threads have all exited by the end of the stretch are ticked here from then on
+    // (they only receive their fills and replies), with their profile counts in this host
+    // thread's lane.
+    const auto idle_in_stretch = [&](const Tm& tm) {
+        return tm.idle_from.load(std::memory_order_relaxed) < end;
+    };
+    for (auto& tm : tms_)
+        if (idle_in_stretch(*tm)) {
+            tm->take_mail();
+            if (tm->profile) {
+                tm->profile = &profile_lanes_[0].profile;
+                tm->outside_text = &profile_lanes_[0].outside_text;
             }
-            // TMs whose threads have all exited still receive their fills and replies.
-            for (auto& tm : tms_)
-                if (tm->idle_from <= now) tm_cycle(*tm, now, source);
-            tick_shared(now);
         }
-        cycles_ = now;
-        for (auto& tm : tms_) {
+    shared_first_progress_ = kNever;
+    shared_last_progress_ = 0;
+    uint64_t now = first;
+    for (; now < end; ++now) {
+        if (!busy(now)) {
+            // Every thread has exited: the write-combining buffers drain, then the chip is
+            // done. (No TM has ticked this cycle: each stops when its last thread exits.)
+            bool drained_lines = false;
+            for (Cache& l2 : l2s_)
+                drained_lines |= l2.drain_write_buffer(now);
+            if (!drained_lines) {
+                finished_ = true;
+                break;
+            }
+        }
+        for (auto& tm : tms_)
+            if (tm->idle_from.load(std::memory_order_relaxed) <= now) tm_cycle(*tm, now, source);
+        tick_shared(now);
+    }
+    cycles_ = now;
+    for (auto& tm : tms_)
+        if (idle_in_stretch(*tm)) {
             first_progress = std::min(first_progress, std::exchange(tm->first_progress, kNever));
             last_progress = std::max(last_progress, std::exchange(tm->last_progress, 0));
         }
-        first_progress = std::min(first_progress, shared_first_progress_);
-        last_progress = std::max(last_progress, shared_last_progress_);
-        // The first cycle the serial loop would have found without progress for too long.
-        const uint64_t stuck = last_progress_cycle_ + kDeadlockCycles + 1;
-        if (stuck < cycles_ && first_progress > stuck)
-            throw std::runtime_error(fmt::format(
-                "timing: deadlock, nothing issued or returned for {} cycles (cycle {}); "
-                "this is a simulator bug, please report it with the config",
-                kDeadlockCycles, stuck));
-        if (first_progress != kNever) last_progress_cycle_ = last_progress;
+    first_progress = std::min(first_progress, shared_first_progress_);
+    last_progress = std::max(last_progress, shared_last_progress_);
+    // The first cycle the serial loop would have found without progress for too long.
+    const uint64_t stuck = last_progress_cycle_ + kDeadlockCycles + 1;
+    if (stuck < cycles_ && first_progress > stuck)
+        throw std::runtime_error(
+            fmt::format("timing: deadlock, nothing issued or returned for {} cycles (cycle {}); "
+                        "this is a simulator bug, please report it with the config",
+                        kDeadlockCycles, stuck));
+    if (first_progress != kNever) last_progress_cycle_ = last_progress;
+    deliver();
+}
+
+void Chip::take_hand_overs(uint64_t& first_progress, uint64_t& last_progress) {
+    for (auto& tm : tms_) {
+        Tm::Outbox& box = tm->outbox;
+        std::lock_guard hold(box.lock);
+        move_to_back(tm->at_shared.requests, box.requests);
+        move_to_back(tm->at_shared.atomics, box.atomics);
+        for (const Tm::ItemCharge& c : box.charges)
+            charge_item(c.item, c.cycles, c.instructions);
+        box.charges.clear();
+        first_progress = std::min(first_progress, std::exchange(box.first_progress, kNever));
+        last_progress = std::max(last_progress, std::exchange(box.last_progress, 0));
     }
 }
 
-void Chip::deliver(uint64_t end) {
+void Chip::deliver() {
     MemReply reply;
     for (Cache& l2 : l2s_)
-        while (l2.pop_reply(end - 1, reply))
-            tms_[reply.request.source]->fills.push_back(
+        while (l2.pop_reply(kNever, reply)) {
+            Tm::Inbox& box = tms_[reply.request.source]->inbox;
+            std::lock_guard hold(box.lock);
+            box.fills.push_back(
                 {reply.ready, reply.request.addr,
                  reply.request.region == fetch_region_ ? reply.request.tag : Tm::kDataLine});
+            box.holds_mail.store(true, std::memory_order_release);
+        }
     AtomicReply atomic;
-    while (global_registers_.pop_reply(end - 1, atomic))
-        tms_[atomic.request.tm]->replies.push_back(atomic);
+    while (global_registers_.pop_reply(kNever, atomic)) {
+        Tm::Inbox& box = tms_[atomic.request.tm]->inbox;
+        std::lock_guard hold(box.lock);
+        box.replies.push_back(atomic);
+        box.holds_mail.store(true, std::memory_order_release);
+    }
 }
 
 template <class Source>
-void Chip::tick_lane(uint32_t lane, uint32_t lanes, uint64_t first, uint64_t end, Source& source) {
-    HostThreads& host = *host_threads_;
+void Chip::tick_tms(uint32_t lane, uint32_t lanes, uint64_t first, uint64_t end, Source& source) {
     const uint64_t tms = tms_.size();
-    uint64_t position = first * tms;
+    const uint32_t from = first_tm(lane, lanes), to = first_tm(lane + 1, lanes);
+    for (uint32_t t = from; t < to; ++t)
+        if (tms_[t]->running != 0) tms_[t]->take_mail();
+    for (uint64_t now = first; now < end; ++now)
+        for (uint32_t t = from; t < to; ++t) {
+            Tm& tm = *tms_[t];
+            if (tm.running == 0) continue;
+            if (tms_in_parallel_) host_threads_->turns.reach(lane, now * tms + t);
+            tm_cycle(tm, now, source);
+        }
+    if (tms_in_parallel_) host_threads_->turns.reach(lane, end * tms);
+    // Every TM that ticked in the stretch (one idle before it is the shared parts').
+    for (uint32_t t = from; t < to; ++t)
+        if (tms_[t]->idle_from.load(std::memory_order_relaxed) > first) tms_[t]->hand_over();
+}
+
+template <class Source>
+bool Chip::tick_lane(uint32_t lane, uint64_t stretch, uint64_t first, uint64_t end,
+                     Source& source) {
+    HostThreads& host = *host_threads_;
     try {
-        for (uint64_t now = first; now < end; ++now)
-            for (uint64_t t = lane; t < tms; t += lanes) {
-                Tm& tm = *tms_[t];
-                if (tm.running == 0) continue;
-                position = now * tms + t;
-                host.turns.reach(lane, position);
-                tm_cycle(tm, now, source);
-            }
-        host.turns.reach(lane, end * tms);
-        return;
+        tick_tms(lane, host.lanes(), first, end, source);
+        return true;
     } catch (const core::OrderedTurns::Abandoned&) {
     } catch (...) {
         // What failed first in the order is what one host thread would have seen: wait until
         // everything before it has happened, so that a fault reports the output printed so far.
+        const uint64_t position = host.turns.position(lane);
         host.turns.wait_turn(lane, position);
         std::exception_ptr error = std::current_exception();
         try {
@@ -815,19 +962,20 @@ void Chip::tick_lane(uint32_t lane, uint32_t lanes, uint64_t first, uint64_t end
         } catch (...) {
         }
         host.failures[lane] = {position, error};
-        uint64_t earliest = host.first_failure.load();
-        while (position < earliest &&
-               !host.first_failure.compare_exchange_weak(earliest, position)) {
-        }
+        // The lanes tick up to this stretch (an earlier failure may yet come), the shared parts
+        // run only the stretches before it.
+        lower(host.lane_limit.value, stretch + 1);
+        lower(host.shared_limit.value, stretch);
+        lower(host.first_failure, position);
     }
     host.turns.reach(lane, core::OrderedTurns::kDone);
+    return false;
 }
 
 void Chip::wait_turn(const Tm& tm, uint64_t now) {
     HostThreads& host = *host_threads_;
-    const uint32_t lanes = host.turns.lanes();
     const uint64_t position = now * tms_.size() + tm.id;
-    host.turns.wait_turn(tm.id % lanes, position);
+    host.turns.wait_turn(tm.lane, position);
     if (host.first_failure.load() < position) throw core::OrderedTurns::Abandoned{};
 }
 
@@ -873,12 +1021,12 @@ void Chip::tick_shared(uint64_t now) {
     }
 
     const uint32_t line_bytes = config_.l2.line_bytes;
-    for (auto& tm : tms_) {
-        auto& out = tm->l1.outbound();
-        Cache& l2 = l2s_[tm->id / config_.chip.tms_per_l2];
+    for (uint32_t t = 0; t < tms_.size(); ++t) {
+        auto& out = tms_[t]->at_shared.requests;
+        Cache& l2 = l2s_[t / config_.chip.tms_per_l2];
         while (!out.empty() && out.front().cycle <= now) {
             MemRequest request = out.front().request;
-            request.source = tm->id;
+            request.source = t;
             const CacheOutcome outcome = l2.access(now, request);
             if (!accepted(outcome)) break;  // retry next cycle, keep FIFO order
             count_access(l2_traffic_[request.region], outcome,
@@ -910,7 +1058,8 @@ void Chip::tick_shared(uint64_t now) {
     dram_.served().clear();
     // Requests sent in an earlier cycle (the TMs have already ticked this one).
     for (auto& tm : tms_)
-        for (auto& out = tm->atomics_out; !out.empty() && out.front().sent < now; out.pop_front())
+        for (auto& out = tm->at_shared.atomics; !out.empty() && out.front().sent < now;
+             out.pop_front())
             global_registers_.submit(out.front());
     global_registers_.tick(now);
 }
@@ -970,7 +1119,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
     Tm::Tp* const tps = tm.tps.data();
     const uint32_t first_thread = tm.id * n;
     auto& counters = tm.counters;
-    bool my_turn = !windows_in_parallel_;
+    bool my_turn = !tms_in_parallel_;
     // Forced inline (GCC keeps a lambda called from two sites out of line): out of line, its
     // captures are reloaded through memory at every use.
     const auto fetch_part = [&](const RotatedPart& part) __attribute__((always_inline)) {
@@ -1136,7 +1285,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             }
             if (s.exited) {
                 clear_bit(tm.awake_tps, i);
-                if (--tm.running == 0) tm.idle_from = now + 1;
+                if (--tm.running == 0) tm.idle_from.store(now + 1, std::memory_order_relaxed);
                 tm.charges.push_back({tp.item, now + 1 - tp.item_since, tp.item_instructions});
                 if (s.atomic_result != 0)  // the exit lets threads at the barrier go on
                     tm.atomics_out.push_back({now, tm.id, tm.atomic_sequence++, i, 0,

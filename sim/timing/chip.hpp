@@ -8,14 +8,15 @@
 // through cycle-stamped queues processed in a fixed order (TM id, then FIFO order), so results
 // never depend on host scheduling.
 //
-// Parallel simulation (docs/hardware-model.md, "Parallel simulation"): the cycles run in windows
-// no longer than the shortest way back from the shared parts to a TM (the lookahead). In a
-// window, the TMs run on the host threads, each with the replies the shared parts had already
-// decided for it; then the shared parts (L2s, DRAM, global registers) run the window's cycles on
-// one thread, taking the TMs' requests in (cycle, TM, FIFO) order. An instruction that touches
-// state other threads can see executes in its turn of the order (cycle, TM, fetch order), as it
-// does when one host thread visits the TMs in id order: results never depend on the number of
-// host threads.
+// Parallel simulation (docs/hardware-model.md, "Parallel simulation"): the TMs run on the host
+// threads in stretches of cycles, each with the fills and replies the shared parts (L2s, DRAM,
+// global registers) had decided for it at least a lookahead earlier (the shortest way back from
+// the shared parts to a TM); the shared parts run the same stretches a little behind on one
+// host thread, taking the TMs' requests in (cycle, TM, FIFO) order. Everything crossing between
+// a TM and the shared parts goes through mailboxes. An instruction that touches state other
+// threads can see executes in its turn of the order (cycle, TM, fetch order), as it does when
+// one host thread visits the TMs in id order: results never depend on the number of host
+// threads.
 #pragma once
 #include "isa/isa.hpp"
 #include "sim/core/machine.hpp"
@@ -158,19 +159,34 @@ private:
     /// The shared parts' work in cycle `now`: DRAM and L2 fills, the TMs' requests to the
     /// L2s (and on to DRAM), the global-register unit. Runs after the TMs' ticks of `now`.
     void tick_shared(uint64_t now);
-    /// Before a window ending at cycle `end` (exclusive): the L2 fills and global-register
-    /// replies each TM receives in it, all decided before the window began (the lookahead).
-    void deliver(uint64_t end);
-    /// run_cycles() on the host threads: windows of TM ticks on every lane, each followed by
-    /// shared_window() on one of them.
-    template <class Source> void run_windows_in_parallel(uint64_t end, Source& source);
-    /// After the TMs' ticks of cycles [first, window_end): their work-item charges, the shared
-    /// parts' ticks (and those of TMs whose threads have all exited) until the window's end or
-    /// the chip's, the deadlock detector.
-    template <class Source> void shared_window(uint64_t first, uint64_t window_end, Source& source);
-    /// One host thread's share of tick_tms: the TMs lane, lane + lanes, ...
+    /// The shared parts' share of cycles [first, end), after the TMs' ticks of them: the TMs'
+    /// hand-overs (requests, work-item charges), the shared parts' ticks (and those of TMs whose
+    /// threads have all exited) until `end` or the chip's end, the deadlock detector, and the
+    /// delivery of the fills and replies decided.
+    template <class Source> void shared_stretch(uint64_t first, uint64_t end, Source& source);
+    /// What each TM handed over since the last call: its requests join the shared parts' own
+    /// queues, its work-item charges the chip's costs, its progress the given cycles.
+    void take_hand_overs(uint64_t& first_progress, uint64_t& last_progress);
+    /// Every fill and reply the shared parts have decided goes to its TM's inbox (each arrives
+    /// a lookahead or more after it was decided).
+    void deliver();
+    /// run_cycles() on the host threads: stretches of TM ticks on every lane, the shared parts'
+    /// stretches on lane 0 a stretch or two behind.
+    template <class Source> void run_pipelined(uint64_t end, Source& source);
+    /// The TMs of host thread `lane` of `lanes` (first_tm) tick cycles [first, end): they take
+    /// their mail first and hand over what they sent after.
     template <class Source>
-    void tick_lane(uint32_t lane, uint32_t lanes, uint64_t first, uint64_t end, Source& source);
+    void tick_tms(uint32_t lane, uint32_t lanes, uint64_t first, uint64_t end, Source& source);
+    /// tick_tms() of stretch `stretch` on a lane of run_pipelined(); false if it failed or
+    /// stopped at another lane's earlier failure (recorded in HostThreads).
+    template <class Source>
+    bool tick_lane(uint32_t lane, uint64_t stretch, uint64_t first, uint64_t end, Source& source);
+    /// The TMs host thread `lane` of `lanes` ticks are [first_tm(lane), first_tm(lane + 1)):
+    /// blocks of consecutive ids, so that two host threads' TMs are neighbours in memory only
+    /// at the blocks' ends.
+    uint32_t first_tm(uint32_t lane, uint32_t lanes) const {
+        return uint32_t(uint64_t{tms_.size()} * lane / lanes);
+    }
     /// One cycle of one TM: what it receives, then (while it has threads) its tick.
     template <class Source> void tm_cycle(Tm& tm, uint64_t now, Source& source);
     /// Waits until every TM simulated on another host thread has passed TM `tm`'s position in
@@ -197,29 +213,18 @@ private:
     bool fetching_ = true;                      // false while drain() empties the chip
     core::Machine* clocked_machine_ = nullptr;  // reads the TMs' clocks through its cycle CSRs
     // The cycle each TM is simulating, for the cycle CSRs; own cache lines (written every tick).
-    struct alignas(64) TmClock {
+    struct alignas(core::kHostSpacing) TmClock {
         uint64_t now = 0;
     };
     std::vector<TmClock> clocks_;
-    uint64_t lookahead_ = 1;                     // cycles per window (at least 1)
+    uint64_t lookahead_ = 1;                     // cycles (at least 1)
     std::unique_ptr<HostThreads> host_threads_;  // none: every TM on the calling thread
     uint32_t lanes_ = 0;                         // host threads the TMs run on; 0: not yet set
     // The TMs are running on the host threads: a step that is not private waits for its turn.
-    bool windows_in_parallel_ = false;
+    bool tms_in_parallel_ = false;
     std::vector<std::unique_ptr<Tm>> tms_;
-    std::vector<Cache> l2s_;
-    Dram dram_;
-    GlobalRegisterUnit global_registers_;
     std::array<Pool, size_t(isa::FuClass::Count)> pool_of_{};
     std::array<uint32_t, size_t(Pool::Count)> latency_of_{};
-    uint64_t cycles_ = 0;
-    uint64_t warmed_instructions_ = 0;
-    // The deadlock detector: the last cycle anything issued or returned, and in the shared
-    // parts' part of the current window, the first and last such cycle.
-    uint64_t last_progress_cycle_ = 0;
-    uint64_t shared_first_progress_ = 0, shared_last_progress_ = 0;
-    bool finished_ = false;
-    uint64_t local_store_high_water_ = 0;  // bytes, max over threads
     // Region lookup: the regions sorted by address, as [begin, end) and their layout index.
     struct RegionBounds {
         uint32_t begin, end;
@@ -228,6 +233,19 @@ private:
     std::vector<RegionBounds> region_bounds_;
     uint8_t other_region_ = 0;  // index of "other": layout_.regions.size()
     uint8_t fetch_region_ = 0;  // of a finite I-cache's line requests: other_region_ + 1
+    // What the shared parts write while the TMs run on other host threads starts on a cache
+    // line of its own: the TMs' ticks read the fields above.
+    alignas(core::kHostSpacing) std::vector<Cache> l2s_;
+    Dram dram_;
+    GlobalRegisterUnit global_registers_;
+    uint64_t cycles_ = 0;
+    uint64_t warmed_instructions_ = 0;
+    // The deadlock detector: the last cycle anything issued or returned, and in the shared
+    // parts' current stretch, the first and last such cycle.
+    uint64_t last_progress_cycle_ = 0;
+    uint64_t shared_first_progress_ = 0, shared_last_progress_ = 0;
+    bool finished_ = false;
+    uint64_t local_store_high_water_ = 0;  // bytes, max over threads
     // Traffic by region (index as MemRequest::region); l1_traffic_ sums the TMs' in collect().
     // The L2 and DRAM also count fetch_region_'s.
     std::vector<LevelTraffic> l1_traffic_, l2_traffic_, dram_traffic_;
@@ -236,7 +254,7 @@ private:
     PcProfile profile_;  // the lanes' sum, in collect()
     // Each host thread counts its TMs' profile in its own lane (lane 0 also takes the shared
     // parts' share); outside_text takes the share of a pc about to fault and is never read.
-    struct ProfileLane {
+    struct alignas(core::kHostSpacing) ProfileLane {
         PcProfile profile;
         PcCounters outside_text;
     };

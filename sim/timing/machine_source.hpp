@@ -130,8 +130,8 @@ private:
     // Each thread's on its own cache lines (as are the machine's threads): the threads of TMs
     // simulated on different host threads must not share a line that both write.
     using Records = std::array<StepInfo, kAhead>;
-    static_assert(sizeof(Records) % 64 == 0);
-    struct alignas(64) AlignedRecords : Records {};
+    static_assert(sizeof(Records) % core::kHostSpacing == 0);
+    struct alignas(core::kHostSpacing) AlignedRecords : Records {};
     // What the chip reads of a thread at every fetch, dense: the pc it fetches next and its
     // place in its records (records[next, size) are run ahead, not yet taken).
     struct Cursor {
@@ -139,9 +139,10 @@ private:
         uint16_t next = 0, size = 0;
     };
     static_assert(kAhead <= UINT16_MAX);
-    // In whole cache lines: TMs of a multiple of 8 threads (32 by default) never share one.
-    static constexpr uint32_t kCursorsPerLine = 8;
-    struct alignas(64) CursorLine {
+    // In whole pairs of cache lines (core::kHostSpacing): TMs of a multiple of 16 threads (32
+    // by default) never share one.
+    static constexpr uint32_t kCursorsPerLine = core::kHostSpacing / sizeof(Cursor);
+    struct alignas(core::kHostSpacing) CursorLine {
         std::array<Cursor, kCursorsPerLine> cursors{};
     };
 

@@ -133,45 +133,39 @@ TEST_CASE("spin barrier: each completion sees every thread's phase, and only the
           "[parallel]") {
     // Every thread writes its own plain slot before arriving; the completion checks that all
     // slots hold the phase and records it; after the barrier each thread checks the record. A
-    // thread that drops out halfway leaves the others going with one fewer. With a leader,
-    // thread 0 always runs the completion.
-    for (const bool leader : {false, true})
-        for (uint32_t count : {2u, 3u, 8u}) {
-            INFO(count << " threads" << (leader ? ", thread 0 leads" : ""));
-            constexpr uint32_t kPhases = 20'000, kDropAt = kPhases / 2;
-            std::vector<uint32_t> slots(count, 0);
-            uint32_t completed = 0, bad = 0, arrivals = count;
-            const auto completion = [&]() noexcept {
-                for (uint32_t t = 0; t < arrivals; ++t)
-                    bad += slots[t] != completed + 1;
-                ++completed;
-                if (completed == kDropAt)
-                    arrivals = count - 1;  // the last thread dropped in this one
-            };
-            core::SpinBarrier barrier(count, completion);
-            std::atomic<uint32_t> late{0};
-            std::vector<std::thread> threads;
-            for (uint32_t t = 0; t < count; ++t)
-                threads.emplace_back([&, t] {
-                    for (uint32_t phase = 1; phase <= kPhases; ++phase) {
-                        slots[t] = phase;
-                        if (t == count - 1 && phase == kDropAt) {
-                            barrier.arrive_and_drop();
-                            return;
-                        }
-                        if (leader && t == 0)
-                            barrier.lead();
-                        else
-                            barrier.arrive_and_wait();
-                        late += completed < phase;
+    // thread that drops out halfway leaves the others going with one fewer.
+    for (uint32_t count : {2u, 3u, 8u}) {
+        INFO(count << " threads");
+        constexpr uint32_t kPhases = 20'000, kDropAt = kPhases / 2;
+        std::vector<uint32_t> slots(count, 0);
+        uint32_t completed = 0, bad = 0, arrivals = count;
+        const auto completion = [&]() noexcept {
+            for (uint32_t t = 0; t < arrivals; ++t)
+                bad += slots[t] != completed + 1;
+            ++completed;
+            if (completed == kDropAt) arrivals = count - 1;  // the last thread dropped in this one
+        };
+        core::SpinBarrier barrier(count, completion);
+        std::atomic<uint32_t> late{0};
+        std::vector<std::thread> threads;
+        for (uint32_t t = 0; t < count; ++t)
+            threads.emplace_back([&, t] {
+                for (uint32_t phase = 1; phase <= kPhases; ++phase) {
+                    slots[t] = phase;
+                    if (t == count - 1 && phase == kDropAt) {
+                        barrier.arrive_and_drop();
+                        return;
                     }
-                });
-            for (std::thread& t : threads)
-                t.join();
-            CHECK(completed == kPhases);
-            CHECK(bad == 0);
-            CHECK(late == 0);
-        }
+                    barrier.arrive_and_wait();
+                    late += completed < phase;
+                }
+            });
+        for (std::thread& t : threads)
+            t.join();
+        CHECK(completed == kPhases);
+        CHECK(bad == 0);
+        CHECK(late == 0);
+    }
 }
 
 TEST_CASE("host thread choice: keeps the faster count, tries the other again ever less often",
