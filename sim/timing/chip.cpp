@@ -68,6 +68,7 @@ void count_access(LevelTraffic& t, CacheOutcome outcome, uint64_t payload, uint6
 
 /// Moves every element of `from` to the back of `to`, in order.
 template <class Queue> void move_to_back(Queue& to, Queue& from) {
+    if (from.empty()) return;  // the usual case: not even a call into the deque
     to.insert(to.end(), std::make_move_iterator(from.begin()), std::make_move_iterator(from.end()));
     from.clear();
 }
@@ -203,19 +204,16 @@ struct alignas(core::kHostSpacing) Chip::Tm {
         inbox.holds_mail.store(false, std::memory_order_relaxed);
     }
     /// After the TM's ticks of a stretch of cycles, on the host thread that ticked it: what it
-    /// sent to the shared parts, its work-item charges and its progress.
+    /// sent to the shared parts and its work-item charges.
     void hand_over() {
         std::deque<OutboundRequest>& sent = l1.outbound();
-        if (sent.empty() && atomics_out.empty() && charges.empty() && first_progress == kNever)
-            return;
+        if (sent.empty() && atomics_out.empty() && charges.empty()) return;
         std::lock_guard hold(outbox.lock);
         move_to_back(outbox.requests, sent);
         move_to_back(outbox.atomics, atomics_out);
         outbox.charges.insert(outbox.charges.end(), charges.begin(), charges.end());
         charges.clear();
-        outbox.first_progress =
-            std::min(outbox.first_progress, std::exchange(first_progress, kNever));
-        outbox.last_progress = std::max(outbox.last_progress, std::exchange(last_progress, 0));
+        outbox.holds_mail.store(true, std::memory_order_release);
     }
     /// Any memory or global-register traffic of this TM in flight (an idle TM: one whose
     /// threads have all exited, ticked by the shared parts' host thread only).
@@ -311,7 +309,7 @@ struct alignas(core::kHostSpacing) Chip::Tm {
     // Deadlock detector: events (issues, replies) so far, and the stretch's first and last
     // cycle with any.
     uint64_t progress = 0;
-    uint64_t first_progress = kNever, last_progress = 0;
+    Progress progress_cycles;
     // What the shared parts' host thread reads of the TM while another host thread may tick it
     // is on cache lines of its own, which the ticks do not write (docs/hardware-model.md,
     // "Parallel simulation"). First the cycle with every thread exited: from then on the shared
@@ -321,10 +319,10 @@ struct alignas(core::kHostSpacing) Chip::Tm {
     struct alignas(
         core::kHostSpacing) Outbox {  // filled by hand_over(), emptied by Chip::take_hand_overs
         std::mutex lock;
+        std::atomic<bool> holds_mail{false};
         std::deque<OutboundRequest> requests;  // to the L2: the L1's and I-cache's, FIFO
         std::deque<AtomicRequest> atomics;     // to the global-register unit
         std::vector<ItemCharge> charges;
-        uint64_t first_progress = kNever, last_progress = 0;
     } outbox;
     struct alignas(core::kHostSpacing) Inbox {  // filled by Chip::deliver, emptied by take_mail()
         std::mutex lock;
@@ -425,7 +423,7 @@ Chip::Chip(const ChipConfig& config, InstructionSource& source, const ChipLayout
 /// The TMs' host threads: lane 0 is the calling thread, lanes 1.. wait for work between runs.
 struct Chip::HostThreads {
     explicit HostThreads(uint32_t lanes)
-        : turns(lanes), ticked(new Count[lanes]), start(lanes), done(lanes) {
+        : turns(lanes), lane(new Lane[lanes]), start(lanes), done(lanes) {
         for (uint32_t lane = 1; lane < lanes; ++lane)
             threads.emplace_back([this, lane] {
                 for (;;) {
@@ -460,13 +458,18 @@ struct Chip::HostThreads {
     std::vector<Failure> failures = std::vector<Failure>(turns.lanes());
     std::atomic<uint64_t> first_failure{core::OrderedTurns::kDone};
     // The pipeline of a run (Chip::run_pipelined), counted in stretches of cycles from its
-    // start: how many each lane has ticked its TMs through, how many the shared parts have
-    // run, and how many of each may run at all (fewer once the chip has finished or
-    // something has failed).
+    // start: how many each lane has ticked its TMs through (and their progress in stretch k,
+    // in progress[k % 2]: a lane is never more than one stretch ahead of the shared parts'
+    // next), how many the shared parts have run, and how many of each may run at all (fewer
+    // once the chip has finished or something has failed).
     struct alignas(core::kHostSpacing) Count {  // one lane writes it, the others read it
         std::atomic<uint64_t> value{0};
     };
-    std::unique_ptr<Count[]> ticked;
+    struct alignas(core::kHostSpacing) Lane {
+        Count ticked;  // publishes `progress`
+        std::array<Progress, 2> progress;
+    };
+    std::unique_ptr<Lane[]> lane;
     Count shared;
     Count lane_limit, shared_limit;
     // Between runs the lanes sleep (after a short spin: runs follow each other closely).
@@ -744,8 +747,8 @@ template <class Source> bool Chip::run_cycles(uint64_t end) {
         while (cycles_ < end && !finished_) {
             const uint64_t first = cycles_;
             const uint64_t stretch_end = std::min(end, first + lookahead_);
-            tick_tms(0, 1, first, stretch_end, source);
-            shared_stretch(first, stretch_end, source);
+            const Progress progress = tick_tms(0, 1, first, stretch_end, source);
+            shared_stretch(first, stretch_end, progress, source);
         }
     }
     finished_ = finished_ || drained();
@@ -761,12 +764,13 @@ template <class Source> void Chip::run_pipelined(uint64_t end, Source& source) {
         ~Serial() { parallel = false; }
     } serial_after{tms_in_parallel_};
     const uint32_t lanes = host.lanes();
-    // Stretches of half the lookahead: the shared parts run stretch k - lag (on lane 0, after
-    // its TMs' share of stretch k) while the other lanes' TMs run stretch k or k + 1. What a TM
-    // receives in stretch k was decided a lookahead earlier, by stretch k - lag - 1 at the
-    // latest; so no lane waits for another unless one falls more than a stretch behind.
+    // Stretches of half the lookahead: the shared parts run stretch k - 1 (on lane 0, after its
+    // TMs' share of stretch k) while the other lanes' TMs run stretch k or k + 1. What a TM
+    // receives in stretch k was decided a lookahead earlier, by stretch k - 2 at the latest; so
+    // no lane waits for another unless one falls more than a stretch behind. (A lookahead of 1
+    // leaves stretches of 1 cycle, each after the shared parts' last.)
     const uint64_t stretch = std::max<uint64_t>(lookahead_ / 2, 1);
-    const uint64_t lag = lookahead_ / stretch - 1;
+    const uint64_t lag = lookahead_ >= 2 ? 1 : 0;
     const uint64_t first = cycles_;
     const auto begin = [&](uint64_t k) { return first + k * stretch; };
     const auto finish = [&](uint64_t k) { return std::min(end, begin(k) + stretch); };
@@ -774,7 +778,7 @@ template <class Source> void Chip::run_pipelined(uint64_t end, Source& source) {
         return c.value.load(std::memory_order_acquire);
     };
     for (uint32_t lane = 0; lane < lanes; ++lane)
-        host.ticked[lane].value = 0;
+        host.lane[lane].ticked.value = 0;
     host.shared.value = 0;
     host.lane_limit.value = host.shared_limit.value = kNever;
     const uint32_t spins = core::spins_for(lanes);
@@ -787,7 +791,6 @@ template <class Source> void Chip::run_pipelined(uint64_t end, Source& source) {
                 [&] { return load(host.shared) + lag >= k || k >= load(host.lane_limit); }, spins);
             if (k >= load(host.lane_limit) || !tick_lane(lane, k, begin(k), finish(k), source))
                 return;
-            host.ticked[lane].value.store(k + 1, std::memory_order_release);
         }
     };
     const auto lead = [&] {
@@ -795,7 +798,6 @@ template <class Source> void Chip::run_pipelined(uint64_t end, Source& source) {
         for (uint64_t k = 0;; ++k) {
             ticking = ticking && begin(k) < end && k < load(host.lane_limit) &&
                       tick_lane(0, k, begin(k), finish(k), source);
-            if (ticking) host.ticked[0].value.store(k + 1, std::memory_order_release);
             const uint64_t s = k - lag;  // the shared parts' stretch, once k >= lag
             if (k < lag) continue;
             if (begin(s) >= end || s >= load(host.shared_limit)) {
@@ -804,11 +806,16 @@ template <class Source> void Chip::run_pipelined(uint64_t end, Source& source) {
             }
             for (uint32_t lane = 1; lane < lanes; ++lane)
                 core::spin_until(
-                    [&] { return load(host.ticked[lane]) > s || s >= load(host.shared_limit); },
+                    [&] {
+                        return load(host.lane[lane].ticked) > s || s >= load(host.shared_limit);
+                    },
                     spins);
             if (s >= load(host.shared_limit)) continue;
+            Progress progress;
+            for (uint32_t lane = 0; lane < lanes; ++lane)
+                progress.add(host.lane[lane].progress[s % 2]);
             try {
-                shared_stretch(begin(s), finish(s), source);
+                shared_stretch(begin(s), finish(s), progress, source);
             } catch (...) {  // nothing from stretch s on counts: the lanes stop
                 shared_error = std::current_exception();
                 lower(host.lane_limit.value, s);
@@ -831,9 +838,9 @@ template <class Source> void Chip::run_pipelined(uint64_t end, Source& source) {
             std::rethrow_exception(failure.error);
 }
 
-template <class Source> void Chip::shared_stretch(uint64_t first, uint64_t end, Source& source) {
-    uint64_t first_progress = kNever, last_progress = 0;
-    take_hand_overs(first_progress, last_progress);
+template <class Source>
+void Chip::shared_stretch(uint64_t first, uint64_t end, Progress progress, Source& source) {
+    take_hand_overs();
     // TMs whose threads have all exited by the end of the stretch are ticked here from then on
     // (they only receive their fills and replies), with their profile counts in this host
     // thread's lane.
@@ -848,8 +855,7 @@ template <class Source> void Chip::shared_stretch(uint64_t first, uint64_t end, 
                 tm->outside_text = &profile_lanes_[0].outside_text;
             }
         }
-    shared_first_progress_ = kNever;
-    shared_last_progress_ = 0;
+    shared_progress_ = {};
     uint64_t now = first;
     for (; now < end; ++now) {
         if (!busy(now)) {
@@ -869,34 +875,30 @@ template <class Source> void Chip::shared_stretch(uint64_t first, uint64_t end, 
     }
     cycles_ = now;
     for (auto& tm : tms_)
-        if (idle_in_stretch(*tm)) {
-            first_progress = std::min(first_progress, std::exchange(tm->first_progress, kNever));
-            last_progress = std::max(last_progress, std::exchange(tm->last_progress, 0));
-        }
-    first_progress = std::min(first_progress, shared_first_progress_);
-    last_progress = std::max(last_progress, shared_last_progress_);
+        if (idle_in_stretch(*tm)) progress.add(std::exchange(tm->progress_cycles, {}));
+    progress.add(shared_progress_);
     // The first cycle the serial loop would have found without progress for too long.
     const uint64_t stuck = last_progress_cycle_ + kDeadlockCycles + 1;
-    if (stuck < cycles_ && first_progress > stuck)
+    if (stuck < cycles_ && progress.first > stuck)
         throw std::runtime_error(
             fmt::format("timing: deadlock, nothing issued or returned for {} cycles (cycle {}); "
                         "this is a simulator bug, please report it with the config",
                         kDeadlockCycles, stuck));
-    if (first_progress != kNever) last_progress_cycle_ = last_progress;
+    if (progress.first != kNever) last_progress_cycle_ = progress.last;
     deliver();
 }
 
-void Chip::take_hand_overs(uint64_t& first_progress, uint64_t& last_progress) {
+void Chip::take_hand_overs() {
     for (auto& tm : tms_) {
         Tm::Outbox& box = tm->outbox;
+        if (!box.holds_mail.load(std::memory_order_acquire)) continue;
         std::lock_guard hold(box.lock);
+        box.holds_mail.store(false, std::memory_order_relaxed);
         move_to_back(tm->at_shared.requests, box.requests);
         move_to_back(tm->at_shared.atomics, box.atomics);
         for (const Tm::ItemCharge& c : box.charges)
             charge_item(c.item, c.cycles, c.instructions);
         box.charges.clear();
-        first_progress = std::min(first_progress, std::exchange(box.first_progress, kNever));
-        last_progress = std::max(last_progress, std::exchange(box.last_progress, 0));
     }
 }
 
@@ -921,7 +923,8 @@ void Chip::deliver() {
 }
 
 template <class Source>
-void Chip::tick_tms(uint32_t lane, uint32_t lanes, uint64_t first, uint64_t end, Source& source) {
+Chip::Progress Chip::tick_tms(uint32_t lane, uint32_t lanes, uint64_t first, uint64_t end,
+                              Source& source) {
     const uint64_t tms = tms_.size();
     const uint32_t from = first_tm(lane, lanes), to = first_tm(lane + 1, lanes);
     for (uint32_t t = from; t < to; ++t)
@@ -935,8 +938,13 @@ void Chip::tick_tms(uint32_t lane, uint32_t lanes, uint64_t first, uint64_t end,
         }
     if (tms_in_parallel_) host_threads_->turns.reach(lane, end * tms);
     // Every TM that ticked in the stretch (one idle before it is the shared parts').
+    Progress progress;
     for (uint32_t t = from; t < to; ++t)
-        if (tms_[t]->idle_from.load(std::memory_order_relaxed) > first) tms_[t]->hand_over();
+        if (Tm& tm = *tms_[t]; tm.idle_from.load(std::memory_order_relaxed) > first) {
+            tm.hand_over();
+            progress.add(std::exchange(tm.progress_cycles, {}));
+        }
+    return progress;
 }
 
 template <class Source>
@@ -944,7 +952,8 @@ bool Chip::tick_lane(uint32_t lane, uint64_t stretch, uint64_t first, uint64_t e
                      Source& source) {
     HostThreads& host = *host_threads_;
     try {
-        tick_tms(lane, host.lanes(), first, end, source);
+        host.lane[lane].progress[stretch % 2] = tick_tms(lane, host.lanes(), first, end, source);
+        host.lane[lane].ticked.value.store(stretch + 1, std::memory_order_release);
         return true;
     } catch (const core::OrderedTurns::Abandoned&) {
     } catch (...) {
@@ -995,10 +1004,7 @@ template <class Source> void Chip::tm_cycle(Tm& tm, uint64_t now, Source& source
     else
         one_word ? tick_tm<Source, 1, false>(tm, now, source)
                  : tick_tm<Source, 0, false>(tm, now, source);
-    if (tm.progress != progress) {
-        tm.first_progress = std::min(tm.first_progress, now);
-        tm.last_progress = now;
-    }
+    if (tm.progress != progress) tm.progress_cycles.add(now);
 }
 
 uint32_t Chip::running_threads() const {
@@ -1016,8 +1022,7 @@ void Chip::tick_shared(uint64_t now) {
     MemReply reply;
     while (dram_.pop_reply(now, reply)) {
         l2s_[reply.request.source].fill(now, reply.request.addr);
-        shared_first_progress_ = std::min(shared_first_progress_, now);
-        shared_last_progress_ = now;
+        shared_progress_.add(now);
     }
 
     const uint32_t line_bytes = config_.l2.line_bytes;

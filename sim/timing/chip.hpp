@@ -29,6 +29,7 @@
 #include "sim/timing/global_registers.hpp"
 #include "sim/timing/icache.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <deque>
@@ -159,14 +160,28 @@ private:
     /// The shared parts' work in cycle `now`: DRAM and L2 fills, the TMs' requests to the
     /// L2s (and on to DRAM), the global-register unit. Runs after the TMs' ticks of `now`.
     void tick_shared(uint64_t now);
-    /// The shared parts' share of cycles [first, end), after the TMs' ticks of them: the TMs'
-    /// hand-overs (requests, work-item charges), the shared parts' ticks (and those of TMs whose
-    /// threads have all exited) until `end` or the chip's end, the deadlock detector, and the
-    /// delivery of the fills and replies decided.
-    template <class Source> void shared_stretch(uint64_t first, uint64_t end, Source& source);
+    /// The first and last cycle anything issued or returned in a stretch (the deadlock
+    /// detector's).
+    struct Progress {
+        uint64_t first = UINT64_MAX, last = 0;
+        void add(uint64_t cycle) {
+            first = std::min(first, cycle);
+            last = std::max(last, cycle);
+        }
+        void add(const Progress& p) {
+            first = std::min(first, p.first);
+            last = std::max(last, p.last);
+        }
+    };
+    /// The shared parts' share of cycles [first, end), after the TMs' ticks of them (whose
+    /// `progress` they report): the TMs' hand-overs (requests, work-item charges), the shared
+    /// parts' ticks (and those of TMs whose threads have all exited) until `end` or the chip's
+    /// end, the deadlock detector, and the delivery of the fills and replies decided.
+    template <class Source>
+    void shared_stretch(uint64_t first, uint64_t end, Progress progress, Source& source);
     /// What each TM handed over since the last call: its requests join the shared parts' own
-    /// queues, its work-item charges the chip's costs, its progress the given cycles.
-    void take_hand_overs(uint64_t& first_progress, uint64_t& last_progress);
+    /// queues, its work-item charges the chip's costs.
+    void take_hand_overs();
     /// Every fill and reply the shared parts have decided goes to its TM's inbox (each arrives
     /// a lookahead or more after it was decided).
     void deliver();
@@ -174,9 +189,9 @@ private:
     /// stretches on lane 0 a stretch or two behind.
     template <class Source> void run_pipelined(uint64_t end, Source& source);
     /// The TMs of host thread `lane` of `lanes` (first_tm) tick cycles [first, end): they take
-    /// their mail first and hand over what they sent after.
+    /// their mail first and hand over what they sent after. Returns their progress.
     template <class Source>
-    void tick_tms(uint32_t lane, uint32_t lanes, uint64_t first, uint64_t end, Source& source);
+    Progress tick_tms(uint32_t lane, uint32_t lanes, uint64_t first, uint64_t end, Source& source);
     /// tick_tms() of stretch `stretch` on a lane of run_pipelined(); false if it failed or
     /// stopped at another lane's earlier failure (recorded in HostThreads).
     template <class Source>
@@ -243,7 +258,7 @@ private:
     // The deadlock detector: the last cycle anything issued or returned, and in the shared
     // parts' current stretch, the first and last such cycle.
     uint64_t last_progress_cycle_ = 0;
-    uint64_t shared_first_progress_ = 0, shared_last_progress_ = 0;
+    Progress shared_progress_;
     bool finished_ = false;
     uint64_t local_store_high_water_ = 0;  // bytes, max over threads
     // Traffic by region (index as MemRequest::region); l1_traffic_ sums the TMs' in collect().
