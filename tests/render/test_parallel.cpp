@@ -229,6 +229,20 @@ TEST_CASE("parallel: the tracer on the cycle-level chip is the same on any host 
     }
 }
 
+TEST_CASE("parallel: the pipeline of any lookahead gives the same results on any host threads",
+          "[parallel]") {
+    // The lookahead min(l2.hit_latency, global-register latency + link) sets the stretches:
+    // 1 cycle each after the shared parts' last (lookahead 1), 1 cycle with the shared parts
+    // a stretch behind (3), 3 cycles (7, one cycle left over).
+    for (const auto& [l2, registers] : {std::pair{1u, 4u}, {3u, 4u}, {9u, 5u}}) {
+        INFO("l2 hit latency " << l2 << ", global-register latency " << registers);
+        render::RenderOptions o = options("tracer", render::Engine::timing, Shape{4, 8}, 16);
+        o.chip.l2.hit_latency = l2;
+        o.chip.global_registers.latency = registers;
+        check_same_for_any_host_threads(o);
+    }
+}
+
 TEST_CASE("parallel: atomics, racing shared loads and stores, barriers, semaphores and prints "
           "are the same on any host threads",
           "[parallel]") {
