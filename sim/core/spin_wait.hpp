@@ -1,8 +1,8 @@
 // Waiting between host threads that meet every few microseconds (the parallel simulation's
-// windows and turns). Sleeping in the kernel costs more than such a wait: a futex wake of a
-// thread whose core went idle takes tens of microseconds on a virtual machine, longer than a
-// window's work. So a waiter spins, with the CPU's pause hint, and only after a while yields
-// its core on every try (on a busy host the thread it waits for may need that core).
+// stretches of cycles and turns). Sleeping in the kernel costs more than such a wait: a futex
+// wake of a thread whose core went idle takes tens of microseconds on a virtual machine, longer
+// than a stretch's work. So a waiter spins, with the CPU's pause hint, and only after a while
+// yields its core on every try (on a busy host the thread it waits for may need that core).
 #pragma once
 #include "sim/core/host_spacing.hpp"
 
@@ -27,7 +27,7 @@ inline void cpu_relax() {
 }
 
 /// How long `lanes` threads that wait for each other should spin before yielding: about ten
-/// windows of 4 TMs (2^14 pauses, 0.19 ms at the 11 ns a pause takes on this project's
+/// 6-cycle windows of 4 TMs (2^14 pauses, 0.19 ms at the 11 ns a pause takes on this project's
 /// machine; 2^11 measured no faster than one thread on a busy machine, where a yield hands the
 /// core to another process for its whole time slice) when each can have a core of its own;
 /// barely, when there are more of them than cores (the one waited for needs a core).
