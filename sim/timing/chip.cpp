@@ -329,6 +329,15 @@ struct alignas(core::kHostSpacing) Chip::Tm {
         std::atomic<bool> holds_mail{false};
         std::deque<Fill> fills;
         std::deque<AtomicReply> replies;
+        void post(const Fill& fill) { post_to(fills, fill); }
+        void post(const AtomicReply& reply) { post_to(replies, reply); }
+
+    private:
+        template <class Queue, class Mail> void post_to(Queue& queue, const Mail& mail) {
+            std::lock_guard hold(lock);
+            queue.push_back(mail);
+            holds_mail.store(true, std::memory_order_release);
+        }
     } inbox;
     // The TM's requests once the shared parts have taken them, until the L2 or the
     // global-register unit accepts each (the shared parts' own).
@@ -832,10 +841,9 @@ template <class Source> void Chip::run_pipelined(uint64_t end, Source& source) {
     };
     host.run([&](uint32_t lane) { lane == 0 ? lead() : follow(lane); });
     if (shared_error) std::rethrow_exception(shared_error);
-    const uint64_t failed = host.first_failure.load();
-    for (const HostThreads::Failure& failure : host.failures)
-        if (failed != core::OrderedTurns::kDone && failure.position == failed)
-            std::rethrow_exception(failure.error);
+    if (const uint64_t failed = host.first_failure.load(); failed != core::OrderedTurns::kDone)
+        for (const HostThreads::Failure& failure : host.failures)
+            if (failure.position == failed) std::rethrow_exception(failure.error);
 }
 
 template <class Source>
@@ -905,21 +913,13 @@ void Chip::take_hand_overs() {
 void Chip::deliver() {
     MemReply reply;
     for (Cache& l2 : l2s_)
-        while (l2.pop_reply(kNever, reply)) {
-            Tm::Inbox& box = tms_[reply.request.source]->inbox;
-            std::lock_guard hold(box.lock);
-            box.fills.push_back(
-                {reply.ready, reply.request.addr,
-                 reply.request.region == fetch_region_ ? reply.request.tag : Tm::kDataLine});
-            box.holds_mail.store(true, std::memory_order_release);
-        }
+        while (l2.pop_reply(kNever, reply))
+            tms_[reply.request.source]->inbox.post(Tm::Fill{
+                reply.ready, reply.request.addr,
+                reply.request.region == fetch_region_ ? reply.request.tag : Tm::kDataLine});
     AtomicReply atomic;
-    while (global_registers_.pop_reply(kNever, atomic)) {
-        Tm::Inbox& box = tms_[atomic.request.tm]->inbox;
-        std::lock_guard hold(box.lock);
-        box.replies.push_back(atomic);
-        box.holds_mail.store(true, std::memory_order_release);
-    }
+    while (global_registers_.pop_reply(kNever, atomic))
+        tms_[atomic.request.tm]->inbox.post(atomic);
 }
 
 template <class Source>
