@@ -1,5 +1,7 @@
 #include "sim/scene/bvh.hpp"
 
+#include "sim/core/huge_pages.hpp"
+
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -137,8 +139,9 @@ protected:
     }
 
     const BvhConfig& config_;
-    std::vector<Box> boxes_;
-    std::vector<glm::vec3> centroids_;
+    // Per triangle, and with the sorted lists below what a large build's page faults are for.
+    core::HugeVector<Box> boxes_;
+    core::HugeVector<glm::vec3> centroids_;
     std::vector<BvhNode> nodes_;
     BvhStats stats_;
     /// Counted from several threads by the sweep builder; copied into the stats at the end.
@@ -147,7 +150,7 @@ protected:
 
 /// Half the range [begin, end) of `order` to each side of the object median by centroid on the
 /// widest centroid axis (index tie-break: deterministic); returns the middle.
-uint32_t partition_at_median(std::vector<uint32_t>& order, const std::vector<glm::vec3>& centroids,
+uint32_t partition_at_median(std::vector<uint32_t>& order, std::span<const glm::vec3> centroids,
                              uint32_t begin, uint32_t end, const Box& centroid_bounds) {
     const glm::vec3 extent = centroid_bounds.hi - centroid_bounds.lo;
     const int axis =
@@ -189,7 +192,7 @@ public:
         goes_right_.resize(n);
         scratch_.resize(n);
         // A binary tree with at most n leaves has at most 2n - 1 nodes.
-        build_nodes_.reset(new BuildNode[2 * n - 1]);
+        build_nodes_ = core::make_huge_array<BuildNode>(2 * n - 1);
     }
 
     Bvh build() {
@@ -245,7 +248,7 @@ private:
     /// 11-bit digits) of keys that order like the floats, started in index order.
     void presort(int axis) {
         const uint32_t n = uint32_t(centroids_.size());
-        std::vector<uint64_t> keys(n), sorted(n);  // key << 32 | triangle
+        core::HugeVector<uint64_t> keys(n), sorted(n);  // key << 32 | triangle
         for (uint32_t i = 0; i < n; ++i) {
             // + 0.f turns -0 into +0, which compares equal to it; then negative floats get
             // their bits flipped, positive ones the sign bit set, so the integers order alike.
@@ -396,11 +399,11 @@ private:
         lay_out(nodes, node.first + 1);
     }
 
-    std::array<std::vector<Ref>, 3> refs_;
-    std::array<std::vector<float>, 3> right_area_;
-    std::vector<uint8_t> goes_right_;  // per triangle, for the partition of its node
-    std::vector<Ref> scratch_;
-    std::unique_ptr<BuildNode[]> build_nodes_;
+    std::array<core::HugeVector<Ref>, 3> refs_;
+    std::array<core::HugeVector<float>, 3> right_area_;
+    core::HugeVector<uint8_t> goes_right_;  // per triangle, for the partition of its node
+    core::HugeVector<Ref> scratch_;
+    core::HugeArray<BuildNode> build_nodes_;
     std::atomic<uint32_t> next_node_{1};  // build_nodes_[0] is the root
 };
 
