@@ -264,9 +264,9 @@ private:
     std::array<uint32_t, kGlobalRegisters> semaphore_holder_;
     trax::KernelOutput output_;
     /// The counters of the threads of TM t in counter_lanes_[t] (t = thread / threads_per_tm),
-    /// each on its own cache lines: TMs simulated on different host threads never write the
-    /// same counters.
-    struct alignas(kHostSpacing) CounterLane {
+    /// kTmSpacing apart: TMs simulated on different host threads never write the same
+    /// counters, nor lines next to them.
+    struct alignas(kTmSpacing) CounterLane {
         Counters counters;
     };
     std::vector<CounterLane> counter_lanes_;

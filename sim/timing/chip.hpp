@@ -227,8 +227,8 @@ private:
     Warming (Chip::*warm_threads_)(uint64_t instructions) = &Chip::warm_threads<InstructionSource>;
     bool fetching_ = true;                      // false while drain() empties the chip
     core::Machine* clocked_machine_ = nullptr;  // reads the TMs' clocks through its cycle CSRs
-    // The cycle each TM is simulating, for the cycle CSRs; own cache lines (written every tick).
-    struct alignas(core::kHostSpacing) TmClock {
+    // The cycle each TM is simulating, for the cycle CSRs; written every tick (kTmSpacing).
+    struct alignas(core::kTmSpacing) TmClock {
         uint64_t now = 0;
     };
     std::vector<TmClock> clocks_;

@@ -53,17 +53,16 @@ inline std::unique_ptr<core::Machine> make_machine(const core::Program& program,
 class MachineSource final : public InstructionSource {
 public:
     explicit MachineSource(core::Machine& machine)
-        : machine_(machine), records_(machine.thread_count()), faults_(machine.thread_count()),
-          cursor_lines_((machine.thread_count() + kCursorsPerLine - 1) / kCursorsPerLine) {
+        : machine_(machine), records_(record_slot(machine.thread_count())),
+          faults_(machine.thread_count()),
+          cursor_lines_(cursor_line(machine.thread_count()) + 1) {
         for (uint32_t t = 0; t < machine.thread_count(); ++t)
             cursor(t).pc = machine.next_pc(t);
     }
 
     core::Machine& machine() const { return machine_; }
 
-    uint32_t next_pc(uint32_t thread) const override {
-        return cursor_lines_[thread / kCursorsPerLine].cursors[thread % kCursorsPerLine].pc;
-    }
+    uint32_t next_pc(uint32_t thread) const override { return cursor(thread).pc; }
 
     /// Records run ahead are private (executed already); so is the next instruction if the
     /// machine says so. A fault waiting for its fetch is not: it must be raised in turn.
@@ -74,7 +73,7 @@ public:
 
     void step(uint32_t thread, StepInfo& out) override {
         Cursor& c = cursor(thread);
-        Records& records = records_[thread];
+        Records& records = records_[record_slot(thread)];
         if (c.next == c.size) run_ahead(thread, c, records);
         out = records[c.next++];
         // The chip takes a thread's records one at a time, among those of a thousand other
@@ -91,7 +90,7 @@ public:
     bool warm(uint32_t thread, uint64_t budget, uint64_t& executed, StepInfo& last,
               Observer& observer) {
         Cursor& c = cursor(thread);
-        const Records& records = records_[thread];
+        const Records& records = records_[record_slot(thread)];
         executed = 0;
         bool stopped = false;
         while (c.next < c.size && executed < budget && !stopped) {
@@ -128,10 +127,14 @@ private:
     static constexpr uint32_t kAhead = 128;  // records buffered per thread
     static constexpr uint32_t kPrefetchAhead = 4;
     // Each thread's on its own cache lines (as are the machine's threads): the threads of TMs
-    // simulated on different host threads must not share a line that both write.
+    // simulated on different host threads must not share a line that both write. Nor come
+    // near one (core::kTmSpacing): after every block of 32 threads (a TM by default; TMs of a
+    // multiple of 32 TPs each start one) one Records is left unused.
     using Records = std::array<StepInfo, kAhead>;
-    static_assert(sizeof(Records) % core::kHostSpacing == 0);
+    static_assert(sizeof(Records) % core::kHostSpacing == 0 && sizeof(Records) >= core::kTmSpacing);
     struct alignas(core::kHostSpacing) AlignedRecords : Records {};
+    static constexpr uint32_t kBlockThreads = 32;
+    static uint32_t record_slot(uint32_t thread) { return thread + thread / kBlockThreads; }
     // What the chip reads of a thread at every fetch, dense: the pc it fetches next and its
     // place in its records (records[next, size) are run ahead, not yet taken).
     struct Cursor {
@@ -140,17 +143,22 @@ private:
     };
     static_assert(kAhead <= UINT16_MAX);
     // In whole pairs of cache lines (core::kHostSpacing): TMs of a multiple of 16 threads (32
-    // by default) never share one.
+    // by default) never share one. Blocks of 32 threads are core::kTmSpacing apart, as above.
     static constexpr uint32_t kCursorsPerLine = core::kHostSpacing / sizeof(Cursor);
     struct alignas(core::kHostSpacing) CursorLine {
         std::array<Cursor, kCursorsPerLine> cursors{};
     };
+    static constexpr uint32_t kBlockLines =
+        kBlockThreads / kCursorsPerLine + core::kTmSpacing / core::kHostSpacing;
+    static uint32_t cursor_line(uint32_t thread) {
+        return thread / kBlockThreads * kBlockLines + thread % kBlockThreads / kCursorsPerLine;
+    }
 
     Cursor& cursor(uint32_t thread) {
-        return cursor_lines_[thread / kCursorsPerLine].cursors[thread % kCursorsPerLine];
+        return cursor_lines_[cursor_line(thread)].cursors[thread % kCursorsPerLine];
     }
     const Cursor& cursor(uint32_t thread) const {
-        return cursor_lines_[thread / kCursorsPerLine].cursors[thread % kCursorsPerLine];
+        return cursor_lines_[cursor_line(thread)].cursors[thread % kCursorsPerLine];
     }
 
     /// A fault of an instruction run ahead is raised when the chip comes to that instruction.
