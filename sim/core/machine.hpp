@@ -51,8 +51,9 @@ struct ThreadSuspended {};
 /// Where an exited thread's pc is parked: below kCodeBase, so never fetchable.
 constexpr uint32_t kParkedPc = 0;
 
-/// On its own cache lines: threads simulated on different host threads never share one.
-struct alignas(64) Thread {
+/// On its own pairs of cache lines (kHostSpacing): threads simulated on different host threads
+/// never share one.
+struct alignas(kHostSpacing) Thread {
     isa::Hart hart;
     ThreadState state = ThreadState::Running;
     int32_t exit_code = 0;  ///< a0 of the exit ecall
