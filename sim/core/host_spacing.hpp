@@ -16,7 +16,7 @@ inline constexpr std::size_t kHostSpacing = 128;
 /// what the next TM's writes: the host's stream prefetchers, which follow a host thread up
 /// through its TMs' entries, fetch a few lines past the last one, and would take the next
 /// TM's lines from the core that writes them at every cycle (bunny 256x256, 4 TMs on 2 host
-/// threads: 7 % less wall time than at kHostSpacing, docs/performance.md).
+/// threads: 13 % less wall time at the best of four runs, docs/performance.md).
 inline constexpr std::size_t kTmSpacing = 512;
 
 }  // namespace tpsim::core
