@@ -54,8 +54,7 @@ class MachineSource final : public InstructionSource {
 public:
     explicit MachineSource(core::Machine& machine)
         : machine_(machine), records_(record_slot(machine.thread_count())),
-          faults_(machine.thread_count()),
-          cursor_lines_(cursor_line(machine.thread_count()) + 1) {
+          faults_(machine.thread_count()), cursor_lines_(cursor_line(machine.thread_count()) + 1) {
         for (uint32_t t = 0; t < machine.thread_count(); ++t)
             cursor(t).pc = machine.next_pc(t);
     }
