@@ -147,6 +147,7 @@ private:
     struct alignas(core::kHostSpacing) CursorLine {
         std::array<Cursor, kCursorsPerLine> cursors{};
     };
+    static_assert(kBlockThreads % kCursorsPerLine == 0, "a block is whole lines of cursors");
     static constexpr uint32_t kBlockLines =
         kBlockThreads / kCursorsPerLine + core::kTmSpacing / core::kHostSpacing;
     static uint32_t cursor_line(uint32_t thread) {
