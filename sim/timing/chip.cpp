@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <atomic>
 #include <bit>
+#include <exception>
 #include <functional>
 #include <iterator>
 #include <mutex>
@@ -129,7 +130,7 @@ struct alignas(core::kHostSpacing) Chip::Tm {
                     ? std::make_unique<ICacheLines>(c.icache, c.chip.tps_per_tm, uint8_t(regions))
                     : nullptr),
           l1(c.l1), awake_tps(words), pending_tps(words), needs_port_tps(words),
-          mem_waiting_tps(words), issuing_tps(words), asking_tps(words),
+          mem_waiting_tps(words), issuing_tps(words), asking_tps(words), shared_next_tps(words),
           wheel_slots(std::min(std::bit_ceil(longest_timed_sleep(c) + 1), kMaxWheelSlots)),
           sleeps_outlast_wheel(longest_timed_sleep(c) >= wheel_slots), wheel(wheel_slots * words),
           l1_traffic(regions) {
@@ -275,8 +276,18 @@ struct alignas(core::kHostSpacing) Chip::Tm {
         }
     }
 
+    /// Whether any thread's next instruction is not private.
+    bool steps_shared_next() const {
+        return std::any_of(shared_next_tps.begin(), shared_next_tps.end(),
+                           [](uint64_t word) { return word != 0; });
+    }
+
     uint32_t id;
     uint32_t lane = 0;  // the host thread that ticks it (Chip::first_tm)
+    // A stretch's cycles from which the TM ticks in the order (cycle, TM), and a fault thrown by
+    // its tick of that cycle before, to be raised there (Chip::tick_tms).
+    uint64_t ordered_from = 0;
+    std::exception_ptr fault_due;
     uint32_t words;     // 64-bit words of a TpBits
     EpochCycles epoch;  // of the TPs' scoreboards
     std::vector<Tp> tps;
@@ -353,6 +364,9 @@ struct alignas(core::kHostSpacing) Chip::Tm {
     TpBits mem_waiting_tps;  // a granted load/store waits for its L1 access
     TpBits issuing_tps;      // won a unit this cycle
     TpBits asking_tps;       // asked for a unit this cycle (kept only when profiling)
+    // Its thread's next instruction is not private (InstructionSource::next_is_private): while
+    // none is, the TM's cycles need no place in the order (cycle, TM) (Chip::tick_tms).
+    TpBits shared_next_tps;
     // Timed sleeps: wheel_slots TpBits (a power of two above the longest sleep, at most
     // kMaxWheelSlots), the one for cycle t at t % wheel_slots.
     static constexpr uint64_t kMaxWheelSlots = 1024;
@@ -427,6 +441,10 @@ Chip::Chip(const ChipConfig& config, InstructionSource& source, const ChipLayout
         std::min<uint64_t>(config.l2.hit_latency,
                            config.global_registers.latency + config.global_registers.link_latency);
     use_host_threads(1);
+    for (auto& tm : tms_)
+        for (uint32_t i = 0; i < config.chip.tps_per_tm; ++i)
+            if (!source.next_is_private(tm->id * config.chip.tps_per_tm + i))
+                set_bit(tm->shared_next_tps, i);
 }
 
 /// The TMs' host threads: lane 0 is the calling thread, lanes 1.. wait for work between runs.
@@ -662,7 +680,12 @@ template <class Source> Chip::Warming Chip::warm_threads(uint64_t instructions) 
                 Tm::Tp& tp = tm->tps[i];
                 WarmingObserver observer{*this, *tm, tp};
                 uint64_t executed = 0;
-                if (warm_thread(source, thread, kTurn, executed, tp.pending, observer)) {
+                const bool stopped =
+                    warm_thread(source, thread, kTurn, executed, tp.pending, observer);
+                clear_bit(tm->shared_next_tps, i);
+                if (!(stopped && tp.pending.exited) && !source.next_is_private(thread))
+                    set_bit(tm->shared_next_tps, i);
+                if (stopped) {
                     // The cycle-level model issues it: the exit counts the thread out, a
                     // synchronisation instruction goes to the global-register unit.
                     tp.pending_pool = pool_of_[size_t(tp.pending.insn->fu)];
@@ -927,13 +950,31 @@ Chip::Progress Chip::tick_tms(uint32_t lane, uint32_t lanes, uint64_t first, uin
                               Source& source) {
     const uint64_t tms = tms_.size();
     const uint32_t from = first_tm(lane, lanes), to = first_tm(lane + 1, lanes);
-    for (uint32_t t = from; t < to; ++t)
-        if (tms_[t]->running != 0) tms_[t]->take_mail();
-    for (uint64_t now = first; now < end; ++now)
+    // Each TM ticks the stretch's cycles in a row, its state hot in the host's caches, until a
+    // thread's next instruction is not private: from that cycle on, the TM ticks in the order
+    // (cycle, TM), where steps other threads can see must happen. A fault on the way is raised
+    // at its place in that order, as one in order would be.
+    uint64_t ordered_from = end;
+    for (uint32_t t = from; t < to; ++t) {
+        Tm& tm = *tms_[t];
+        if (tm.running == 0) continue;
+        tm.take_mail();
+        uint64_t now = first;
+        try {
+            for (; now < end && tm.running != 0 && !tm.steps_shared_next(); ++now)
+                tm_cycle(tm, now, source);
+        } catch (...) {
+            tm.fault_due = std::current_exception();
+        }
+        tm.ordered_from = now;
+        ordered_from = std::min(ordered_from, now);
+    }
+    for (uint64_t now = ordered_from; now < end; ++now)
         for (uint32_t t = from; t < to; ++t) {
             Tm& tm = *tms_[t];
-            if (tm.running == 0) continue;
+            if (tm.running == 0 || tm.ordered_from > now) continue;
             if (tms_in_parallel_) host_threads_->turns.reach(lane, now * tms + t);
+            if (tm.fault_due) std::rethrow_exception(std::exchange(tm.fault_due, nullptr));
             tm_cycle(tm, now, source);
         }
     if (tms_in_parallel_) host_threads_->turns.reach(lane, end * tms);
@@ -1141,7 +1182,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             }
         const uint64_t fetched =
             tm.lines ? fetch_lines<Source, kProfile>(tm, part, granted, now, source) : granted;
-        uint64_t needs_port = 0;
+        uint64_t needs_port = 0, shared_next = 0;
         for (uint64_t bits = fetched; bits != 0; bits &= bits - 1) {
             const auto bit = static_cast<uint32_t>(std::countr_zero(bits));
             const uint32_t i = part.index(bit);
@@ -1151,6 +1192,8 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
                 my_turn = true;
             }
             source.step(first_thread + i, tp.pending);
+            shared_next |= uint64_t{!tp.pending.exited && !source.next_is_private(first_thread + i)}
+                           << bit;
             tp.pending_pool = pool_of_[size_t(tp.pending.insn->fu)];
             const bool global_access =  // bitwise &: no branch on an unpredictable outcome
                 (tp.pending_pool == Pool::LoadStore) &
@@ -1158,6 +1201,8 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             needs_port |= uint64_t{global_access} << bit;
         }
         tm.needs_port_tps[w] |= part.back(needs_port);
+        tm.shared_next_tps[w] =
+            (tm.shared_next_tps[w] & ~part.back(fetched)) | part.back(shared_next);
         tm.pending_tps[w] |= part.back(fetched);
     };
     if (fetching_) for_each_rotated_part(words, tm.rotation, fetch_part);

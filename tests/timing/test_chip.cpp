@@ -9,6 +9,7 @@
 #include <deque>
 #include <regex>
 #include <sstream>
+#include <stdexcept>
 
 using namespace tpsim::timing;
 using tpsim::isa::Decoded;
@@ -56,6 +57,8 @@ public:
     }
     uint32_t next_pc(uint32_t thread) const override { return trace_[thread][next_[thread]].pc; }
     void step(uint32_t thread, StepInfo& out) override { out = trace_[thread].at(next_[thread]++); }
+    /// Instructions thread `thread` has executed.
+    size_t steps(uint32_t thread) const { return next_[thread]; }
 
 private:
     std::deque<Decoded> decoded_;  // stable addresses
@@ -271,5 +274,37 @@ TEST_CASE("every registered key is documented in docs/statistics.md", "[chip][do
                         [&](const std::regex& re) { return std::regex_match(e.name, re); });
         INFO(e.name);
         CHECK(found);
+    }
+}
+
+TEST_CASE("a fault in a private step is raised in its turn of the order (cycle, TM)",
+          "[chip][parallel]") {
+    // TM 1's thread steps privately and faults at its fifth instruction; TM 0's steps are not
+    // private. The cycle loop may run TM 1's private steps ahead of TM 0's cycles, but its
+    // fault is raised in its turn: both TMs fetch one instruction a cycle, so TM 0 has made
+    // exactly five steps by then (its fifth in the same cycle, before TM 1), on any host
+    // threads.
+    struct FaultingScript : Script {
+        using Script::Script;
+        bool next_is_private(uint32_t thread) const override { return thread == 1; }
+        void step(uint32_t thread, StepInfo& out) override {
+            if (thread == 1 && steps(1) == 4) throw std::runtime_error("fault in thread 1");
+            Script::step(thread, out);
+        }
+    };
+    for (uint32_t host_threads : {1u, 2u}) {
+        INFO("host threads " << host_threads);
+        ChipConfig c = one_tp();
+        c.chip.num_tms = 2;
+        FaultingScript s(2);
+        for (int i = 0; i < 1000; ++i)
+            for (uint32_t t = 0; t < 2; ++t)
+                s.add(t, Op::add, x(5 + i % 3), x(1), x(2));
+        s.finish();
+        Chip chip(c, s);
+        chip.use_host_threads(host_threads);
+        CHECK_THROWS_WITH(chip.run(), "fault in thread 1");
+        CHECK(s.steps(0) == 5);
+        CHECK(s.steps(1) == 4);
     }
 }
