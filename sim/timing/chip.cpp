@@ -487,9 +487,10 @@ struct Chip::HostThreads {
     // The pipeline of a run (Chip::run_pipelined), counted in stretches of cycles from its
     // start: how many each lane has ticked its TMs through (and their progress in stretch k,
     // in progress[k % 2]: a lane is never more than one stretch ahead of the shared parts'
-    // next), how many the shared parts have run, and how many of each may run at all (fewer
-    // once the chip has finished or something has failed).
-    struct alignas(core::kHostSpacing) Count {  // one lane writes it, the others read it
+    // next), how many of the shared parts' stretches a lane has taken on and how many have run,
+    // and how many of each may run at all (fewer once the chip has finished or something has
+    // failed).
+    struct alignas(core::kHostSpacing) Count {
         std::atomic<uint64_t> value{0};
     };
     struct alignas(core::kHostSpacing) Lane {
@@ -497,7 +498,7 @@ struct Chip::HostThreads {
         std::array<Progress, 2> progress;
     };
     std::unique_ptr<Lane[]> lane;
-    Count shared;
+    Count shared_taken, shared;
     Count lane_limit, shared_limit;
     // Between runs the lanes sleep (after a short spin: runs follow each other closely).
     core::SpinBarrier<> start, done;
@@ -513,7 +514,7 @@ void Chip::use_host_threads(uint32_t threads) {
     if (layout_.profile) collect();  // the lanes' counts so far go on in lane 0
     host_threads_.reset();
     if (lanes > 1) host_threads_ = std::make_unique<HostThreads>(lanes);
-    profile_lanes_.assign(layout_.profile ? lanes : 0, {});
+    profile_lanes_.assign(layout_.profile ? lanes + 1 : 0, {});  // the last: the shared parts'
     for (ProfileLane& lane : profile_lanes_) {
         lane.profile.text = layout_.text;
         lane.profile.words.resize(profile_.words.size());
@@ -796,11 +797,11 @@ template <class Source> void Chip::run_pipelined(uint64_t end, Source& source) {
         ~Serial() { parallel = false; }
     } serial_after{tms_in_parallel_};
     const uint32_t lanes = host.lanes();
-    // Stretches of half the lookahead: the shared parts run stretch k - 1 (on lane 0, after its
-    // TMs' share of stretch k) while the other lanes' TMs run stretch k or k + 1. What a TM
-    // receives in stretch k was decided a lookahead earlier, by stretch k - 2 at the latest; so
-    // no lane waits for another unless one falls more than a stretch behind. (A lookahead of 1
-    // leaves stretches of 1 cycle, each after the shared parts' last.)
+    // Stretches of half the lookahead: the shared parts run stretch s once every lane has
+    // ticked it, while the lanes' TMs run stretch s + 1 or s + 2. What a TM receives in
+    // stretch k was decided a lookahead earlier, by stretch k - 2 at the latest; so no lane
+    // waits for another unless one falls more than a stretch behind. (A lookahead of 1 leaves
+    // stretches of 1 cycle, each after the shared parts' last.)
     const uint64_t stretch = std::max<uint64_t>(lookahead_ / 2, 1);
     const uint64_t lag = lookahead_ >= 2 ? 1 : 0;
     const uint64_t first = cycles_;
@@ -811,58 +812,64 @@ template <class Source> void Chip::run_pipelined(uint64_t end, Source& source) {
     };
     for (uint32_t lane = 0; lane < lanes; ++lane)
         host.lane[lane].ticked.value = 0;
-    host.shared.value = 0;
+    host.shared_taken.value = host.shared.value = 0;
     host.lane_limit.value = host.shared_limit.value = kNever;
     const uint32_t spins = core::spins_for(lanes);
     std::exception_ptr shared_error;
 
-    const auto follow = [&](uint32_t lane) {
+    // The shared parts' next stretch, on the first lane to come for it once every lane has
+    // ticked it: the lane with the least work in the stretch, whichever that is (a fixed lane
+    // would carry the serial work on top of its TMs', and the others would wait for it).
+    // Returns whether it ran one.
+    const auto run_shared = [&] {
+        const uint64_t s = load(host.shared);
+        if (begin(s) >= end || s >= load(host.shared_limit)) return false;
+        for (uint32_t lane = 0; lane < lanes; ++lane)
+            if (load(host.lane[lane].ticked) <= s) return false;
+        uint64_t untaken = s;  // no lane has taken stretch s on (nor is running an earlier one)
+        if (!host.shared_taken.value.compare_exchange_strong(untaken, s + 1)) return false;
+        Progress progress;
+        for (uint32_t lane = 0; lane < lanes; ++lane)
+            progress.add(host.lane[lane].progress[s % 2]);
+        try {
+            shared_stretch(begin(s), finish(s), progress, source);
+        } catch (...) {  // nothing from stretch s on counts: the lanes stop
+            shared_error = std::current_exception();
+            lower(host.lane_limit.value, s);
+            lower(host.shared_limit.value, s);
+            return true;
+        }
+        if (finished_) {  // the lanes' later stretches have only idle TMs: they stop
+            lower(host.lane_limit.value, s + 1);
+            lower(host.shared_limit.value, s + 1);
+        }
+        host.shared.value.store(s + 1, std::memory_order_release);
+        return true;
+    };
+    const auto lane_work = [&](uint32_t lane) {
         for (uint64_t k = 0; begin(k) < end; ++k) {
             // Stretch k receives what the shared parts' stretch k - lag - 1 decided.
-            core::spin_until(
-                [&] { return load(host.shared) + lag >= k || k >= load(host.lane_limit); }, spins);
-            if (k >= load(host.lane_limit) || !tick_lane(lane, k, begin(k), finish(k), source))
-                return;
+            const auto may_tick = [&] {
+                return load(host.shared) + lag >= k || k >= load(host.lane_limit);
+            };
+            core::spin_until([&] { return may_tick() || (run_shared() && may_tick()); }, spins);
+            if (k >= load(host.lane_limit)) {  // stopped early: other lanes' steps wait no more
+                host.turns.reach(lane, core::OrderedTurns::kDone);
+                break;
+            }
+            if (!tick_lane(lane, k, begin(k), finish(k), source)) break;
+            run_shared();
         }
+        // The shared parts' stretches left, on whichever lanes come for them.
+        core::spin_until(
+            [&] {
+                run_shared();
+                const uint64_t s = load(host.shared);
+                return begin(s) >= end || s >= load(host.shared_limit);
+            },
+            spins);
     };
-    const auto lead = [&] {
-        bool ticking = true;
-        for (uint64_t k = 0;; ++k) {
-            ticking = ticking && begin(k) < end && k < load(host.lane_limit) &&
-                      tick_lane(0, k, begin(k), finish(k), source);
-            const uint64_t s = k - lag;  // the shared parts' stretch, once k >= lag
-            if (k < lag) continue;
-            if (begin(s) >= end || s >= load(host.shared_limit)) {
-                if (!ticking) return;
-                continue;
-            }
-            for (uint32_t lane = 1; lane < lanes; ++lane)
-                core::spin_until(
-                    [&] {
-                        return load(host.lane[lane].ticked) > s || s >= load(host.shared_limit);
-                    },
-                    spins);
-            if (s >= load(host.shared_limit)) continue;
-            Progress progress;
-            for (uint32_t lane = 0; lane < lanes; ++lane)
-                progress.add(host.lane[lane].progress[s % 2]);
-            try {
-                shared_stretch(begin(s), finish(s), progress, source);
-            } catch (...) {  // nothing from stretch s on counts: the lanes stop
-                shared_error = std::current_exception();
-                lower(host.lane_limit.value, s);
-                lower(host.shared_limit.value, s);
-                host.turns.reach(0, core::OrderedTurns::kDone);
-                return;
-            }
-            if (finished_) {  // the lanes' later stretches have only idle TMs: they stop
-                lower(host.lane_limit.value, s + 1);
-                lower(host.shared_limit.value, s + 1);
-            }
-            host.shared.value.store(s + 1, std::memory_order_release);
-        }
-    };
-    host.run([&](uint32_t lane) { lane == 0 ? lead() : follow(lane); });
+    host.run(lane_work);
     if (shared_error) std::rethrow_exception(shared_error);
     if (const uint64_t failed = host.first_failure.load(); failed != core::OrderedTurns::kDone)
         for (const HostThreads::Failure& failure : host.failures)
@@ -882,8 +889,8 @@ void Chip::shared_stretch(uint64_t first, uint64_t end, Progress progress, Sourc
         if (idle_in_stretch(*tm)) {
             tm->take_mail();
             if (tm->profile) {
-                tm->profile = &profile_lanes_[0].profile;
-                tm->outside_text = &profile_lanes_[0].outside_text;
+                tm->profile = &profile_lanes_.back().profile;
+                tm->outside_text = &profile_lanes_.back().outside_text;
             }
         }
     shared_progress_ = {};
@@ -1091,7 +1098,7 @@ void Chip::tick_shared(uint64_t now) {
         }
     }
     dram_.tick(now);
-    PcProfile* profile = profile_lanes_.empty() ? nullptr : &profile_lanes_[0].profile;
+    PcProfile* profile = profile_lanes_.empty() ? nullptr : &profile_lanes_.back().profile;
     for (const MemRequest& served : dram_.served()) {
         LevelTraffic& t = dram_traffic_[served.region];
         ++(served.write ? t.writes : t.reads);

@@ -186,7 +186,7 @@ private:
     /// a lookahead or more after it was decided).
     void deliver();
     /// run_cycles() on the host threads: stretches of TM ticks on every lane, the shared parts'
-    /// stretches on lane 0 a stretch or two behind.
+    /// stretches a stretch or two behind, each on the first lane free for it.
     template <class Source> void run_pipelined(uint64_t end, Source& source);
     /// The TMs of host thread `lane` of `lanes` (first_tm) tick cycles [first, end): they take
     /// their mail first and hand over what they sent after. Returns their progress.
@@ -267,8 +267,9 @@ private:
     uint64_t local_payload_bytes_ = 0;  // summed in collect()
     WorkItemCosts work_items_;
     PcProfile profile_;  // the lanes' sum, in collect()
-    // Each host thread counts its TMs' profile in its own lane (lane 0 also takes the shared
-    // parts' share); outside_text takes the share of a pc about to fault and is never read.
+    // Each host thread counts its TMs' profile in its own lane, the shared parts (and the TMs
+    // they tick) in the last; outside_text takes the share of a pc about to fault and is never
+    // read.
     struct alignas(core::kHostSpacing) ProfileLane {
         PcProfile profile;
         PcCounters outside_text;
