@@ -817,9 +817,9 @@ template <class Source> void Chip::run_pipelined(uint64_t end, Source& source) {
     const uint32_t spins = core::spins_for(lanes);
     std::exception_ptr shared_error;
 
-    // The shared parts' next stretch, on the first lane to come for it once every lane has
-    // ticked it: the lane with the least work in the stretch, whichever that is (a fixed lane
-    // would carry the serial work on top of its TMs', and the others would wait for it).
+    // The shared parts' next stretch, once every lane has ticked it, on one lane at a time:
+    // lane 0 after its TMs' stretch (their state stays in its core's caches), or a lane that
+    // would otherwise wait for it (lane 0 carries the serial work on top of its TMs').
     // Returns whether it ran one.
     const auto run_shared = [&] {
         const uint64_t s = load(host.shared);
@@ -858,7 +858,7 @@ template <class Source> void Chip::run_pipelined(uint64_t end, Source& source) {
                 break;
             }
             if (!tick_lane(lane, k, begin(k), finish(k), source)) break;
-            run_shared();
+            if (lane == 0) run_shared();
         }
         // The shared parts' stretches left, on whichever lanes come for them.
         core::spin_until(

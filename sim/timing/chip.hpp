@@ -186,7 +186,7 @@ private:
     /// a lookahead or more after it was decided).
     void deliver();
     /// run_cycles() on the host threads: stretches of TM ticks on every lane, the shared parts'
-    /// stretches a stretch or two behind, each on the first lane free for it.
+    /// stretches a stretch or two behind, on lane 0 or a lane that would wait for them.
     template <class Source> void run_pipelined(uint64_t end, Source& source);
     /// The TMs of host thread `lane` of `lanes` (first_tm) tick cycles [first, end): they take
     /// their mail first and hand over what they sent after. Returns their progress.

@@ -67,7 +67,7 @@ public:
     /// machine says so. A fault waiting for its fetch is not: it must be raised in turn.
     bool next_is_private(uint32_t thread) const override {
         const Cursor& c = cursor(thread);
-        return c.next < c.size || (!faults_[thread] && machine_.next_is_private(thread));
+        return c.next < c.size || next_unbuffered_is_private(thread);
     }
 
     void step(uint32_t thread, StepInfo& out) override {
@@ -159,6 +159,12 @@ private:
     }
     const Cursor& cursor(uint32_t thread) const {
         return cursor_lines_[cursor_line(thread)].cursors[thread % kCursorsPerLine];
+    }
+
+    /// next_is_private() of a thread with nothing buffered: out of line, as it is rare (the
+    /// chip asks at every fetch).
+    [[gnu::noinline]] bool next_unbuffered_is_private(uint32_t thread) const {
+        return !faults_[thread] && machine_.next_is_private(thread);
     }
 
     /// A fault of an instruction run ahead is raised when the chip comes to that instruction.
