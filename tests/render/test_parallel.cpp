@@ -258,23 +258,29 @@ TEST_CASE("parallel: atomics, racing shared loads and stores, barriers, semaphor
 
 TEST_CASE("parallel: a fault reports the same thread and output on any host threads",
           "[parallel]") {
-    for (const render::Engine engine : {render::Engine::timing, render::Engine::functional})
-        for (const Shape shape : {Shape{4, 8}, Shape{3, 5}}) {
-            INFO((engine == render::Engine::timing ? "cycle-level " : "functional ")
-                 << shape.tms << " TMs x " << shape.tps << " TPs");
-            const render::RenderOptions o = options("fault_race", engine, shape, 8);
-            std::string first;
-            for (uint32_t threads : kHostThreads) {
-                INFO("host threads " << threads);
-                core::set_host_threads(threads);
-                const std::string fault = fault_of(o);
-                CHECK(fault.find("is not an RV32IMF instruction") != std::string::npos);
-                if (first.empty())
-                    first = fault;
-                else
-                    CHECK(fault == first);
+    // An illegal instruction, and a store into the stack's overflow guard (a private step).
+    for (const auto& [param, message] :
+         {std::pair{"private_fault=0", "is not an RV32IMF instruction"},
+          std::pair{"private_fault=1", "stack overflow"}})
+        for (const render::Engine engine : {render::Engine::timing, render::Engine::functional})
+            for (const Shape shape : {Shape{4, 8}, Shape{3, 5}}) {
+                INFO(param << ", "
+                           << (engine == render::Engine::timing ? "cycle-level " : "functional ")
+                           << shape.tms << " TMs x " << shape.tps << " TPs");
+                render::RenderOptions o = options("fault_race", engine, shape, 8);
+                o.params = {param};
+                std::string first;
+                for (uint32_t threads : kHostThreads) {
+                    INFO("host threads " << threads);
+                    core::set_host_threads(threads);
+                    const std::string fault = fault_of(o);
+                    CHECK(fault.find(message) != std::string::npos);
+                    if (first.empty())
+                        first = fault;
+                    else
+                        CHECK(fault == first);
+                }
             }
-        }
 }
 
 TEST_CASE("parallel: sampled simulation is the same on any host threads", "[parallel]") {
