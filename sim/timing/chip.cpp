@@ -966,6 +966,8 @@ Chip::Progress Chip::tick_tms(uint32_t lane, uint32_t lanes, uint64_t first, uin
         Tm& tm = *tms_[t];
         if (tm.running == 0) continue;
         tm.take_mail();
+        for (uint32_t i = 0, n = config_.chip.tps_per_tm; i < n; ++i)
+            source.prefetch_next(tm.id * n + i);
         uint64_t now = first;
         try {
             for (; now < end && tm.running != 0 && !tm.steps_shared_next(); ++now)

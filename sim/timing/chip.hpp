@@ -55,6 +55,9 @@ public:
     /// (shared memory, atomics, synchronisation, printing, faults) run in the chip's fixed
     /// order. The default is safe for any source: no step is private.
     virtual bool next_is_private(uint32_t /*thread*/) const { return false; }
+    /// The chip is about to tick thread `thread`'s TM for a few cycles: a hint to bring what
+    /// its next step reads into the host's caches. The default does nothing.
+    virtual void prefetch_next(uint32_t /*thread*/) const {}
 };
 
 class MachineSource;  // machine_source.hpp
