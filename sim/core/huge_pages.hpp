@@ -4,8 +4,8 @@
 // costs 512 times fewer, and fewer TLB entries cover the array afterwards. Where the kernel
 // gives huge pages only on request (/sys/kernel/mm/transparent_hugepage/enabled: madvise, as on
 // Debian), an array must ask for them: std::vector<T, HugePageAllocator<T>> (HugeVector<T>)
-// does, for blocks of at least one huge page; smaller ones come from operator new as usual.
-// make_huge_array<T>(n) gives n uninitialised elements, whose pages are touched only as used.
+// and make_huge_array<T>(n) (n uninitialised elements, whose pages are touched only as used)
+// do, for blocks of at least one huge page; smaller ones are ordinary heap blocks.
 #pragma once
 #include <cstddef>
 #include <memory>
@@ -18,9 +18,11 @@ namespace tpsim::core {
 /// The huge-page size asked for (x86-64 and most AArch64 kernels).
 inline constexpr std::size_t kHugePageBytes = std::size_t{2} << 20;
 
-/// Allocates `bytes` aligned to a huge page, in whole huge pages, and asks the kernel to back
-/// them with huge pages (a request: without them the block is ordinary memory).
-void* allocate_huge(std::size_t bytes);
+/// Allocates `bytes` aligned to `alignment` (a power of two). A block of at least one huge
+/// page is aligned to a huge page, in whole huge pages, and the kernel is asked to back it with
+/// huge pages (a request: without them it is ordinary memory); a smaller one is an ordinary heap
+/// block. Either is freed by free_huge.
+void* allocate_huge(std::size_t bytes, std::size_t alignment);
 void free_huge(void* block) noexcept;
 
 struct FreeHuge {
@@ -31,7 +33,7 @@ template <class T> using HugeArray = std::unique_ptr<T[], FreeHuge>;
 template <class T> HugeArray<T> make_huge_array(std::size_t n) {
     static_assert(std::is_trivial_v<T>, "elements are left uninitialised");
     if (n > std::size_t(-1) / sizeof(T)) throw std::bad_array_new_length();
-    return HugeArray<T>(static_cast<T*>(allocate_huge(n * sizeof(T))));
+    return HugeArray<T>(static_cast<T*>(allocate_huge(n * sizeof(T), alignof(T))));
 }
 
 template <class T> struct HugePageAllocator {
@@ -42,17 +44,9 @@ template <class T> struct HugePageAllocator {
 
     T* allocate(std::size_t n) {
         if (n > max_size()) throw std::bad_array_new_length();
-        const std::size_t bytes = n * sizeof(T);
-        if (bytes >= kHugePageBytes) return static_cast<T*>(allocate_huge(bytes));
-        return static_cast<T*>(::operator new (bytes, std::align_val_t{alignof(T)}));
+        return static_cast<T*>(allocate_huge(n * sizeof(T), alignof(T)));
     }
-    // The size decides the path both ways: a vector frees with the count it allocated.
-    void deallocate(T* p, std::size_t n) noexcept {
-        if (n * sizeof(T) >= kHugePageBytes)
-            free_huge(p);
-        else
-            ::operator delete (p, std::align_val_t{alignof(T)});
-    }
+    void deallocate(T* p, std::size_t) noexcept { free_huge(p); }
     static constexpr std::size_t max_size() { return std::size_t(-1) / sizeof(T); }
 
     template <class U> bool operator==(const HugePageAllocator<U>&) const noexcept { return true; }

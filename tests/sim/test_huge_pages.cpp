@@ -79,10 +79,14 @@ TEST_CASE("huge pages: a small vector is ordinary memory with its type's alignme
 }
 
 TEST_CASE("huge pages: an array for a few elements or for many") {
-    const HugeArray<uint32_t> few = make_huge_array<uint32_t>(3);
-    REQUIRE(aligned(few.get(), kHugePageBytes));
-    few[2] = 5;
-    CHECK(few[2] == 5);
+    // A few: ordinary heap blocks with the type's alignment, as a vector's, not a huge page
+    // each (two such blocks could not both start on one).
+    const HugeArray<Line> few = make_huge_array<Line>(3), other = make_huge_array<Line>(3);
+    REQUIRE(aligned(few.get(), alignof(Line)));
+    REQUIRE(aligned(other.get(), alignof(Line)));
+    CHECK_FALSE((aligned(few.get(), kHugePageBytes) && aligned(other.get(), kHugePageBytes)));
+    few[2].words[7] = 5;
+    CHECK(few[2].words[7] == 5);
     const HugeArray<float> many = make_huge_array<float>(3 << 20);
     REQUIRE(aligned(many.get(), kHugePageBytes));
     many[(3 << 20) - 1] = 1.5f;
