@@ -12,6 +12,7 @@
 
 #include "sim/core/error.hpp"
 #include "sim/render/image_codec.hpp"
+#include "sim/render/png_file.hpp"
 
 namespace tpsim::analysis {
 namespace {
@@ -78,8 +79,9 @@ std::string png_bytes(const std::filesystem::path& path) {
         if (linear) v = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1 / 2.4f) - 0.055f;
         encoded[i] = static_cast<uint8_t>(std::lround(v * 255));
     }
-    std::string png = render::image_codec().encode_png(pixels->layout, encoded);
-    if (png.empty()) throw Error(fmt::format("cannot convert image {} to PNG", path.string()));
+    std::string png = render::encode_png(pixels->layout, encoded, error);
+    if (png.empty())
+        throw Error(fmt::format("cannot convert image {} to PNG: {}", path.string(), error));
     return png;
 }
 

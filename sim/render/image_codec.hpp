@@ -1,5 +1,6 @@
 // The interface of the image module: what tpsim asks of OpenImageIO, loaded on first use
-// (sim/core/module.hpp) so that commands without an image never load OpenImageIO's libraries.
+// (sim/core/module.hpp) so that commands without an image never load OpenImageIO's libraries,
+// nor does a render that writes a PNG (png_file.hpp).
 #pragma once
 #include <array>
 #include <cstdint>
@@ -56,9 +57,6 @@ public:
                        std::span<const float> pixels, std::string& error) const = 0;
     virtual bool write(const std::string& path, const ImageLayout& file,
                        std::span<const uint8_t> pixels, std::string& error) const = 0;
-    /// The 8-bit pixels as PNG file bytes; empty on failure.
-    virtual std::string encode_png(const ImageLayout& layout,
-                                   std::span<const uint8_t> pixels) const = 0;
     /// Both images hold floats in the same layout. One thread, so the sums are always added in
     /// the same order.
     virtual PixelDifference compare(const Image& a, const Image& b) const = 0;
@@ -77,5 +75,13 @@ protected:
 
 /// The image module, loaded on the first call; throws tpsim::Error if it cannot be loaded.
 const ImageCodec& image_codec();
+
+/// Whether an image can be written at `path` (its extension): a PNG always (png_file.hpp),
+/// another format if the image module has a writer for it.
+bool can_write_image(const std::string& path);
+/// Writes 8-bit pixels as ImageCodec::write does: a PNG with libpng, without loading the image
+/// module; another format through the module.
+bool write_image_bytes(const std::string& path, const ImageLayout& file,
+                       std::span<const uint8_t> pixels, std::string& error);
 
 }  // namespace tpsim::render

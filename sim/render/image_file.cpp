@@ -38,7 +38,7 @@ float decode_srgb(uint8_t value) {
 }
 
 void check_image_path(const std::filesystem::path& path) {
-    if (!image_codec().can_write(path.string())) {
+    if (!can_write_image(path.string())) {
         throw Error(fmt::format(
             "cannot write image '{}': {}; use .png, .exr, .tif, .ppm ...", path.string(),
             path.has_extension()
@@ -61,7 +61,7 @@ void write_image(const std::filesystem::path& path, std::span<const float> rgb, 
     } else {
         std::vector<uint8_t> bytes(rgb.size());
         std::transform(rgb.begin(), rgb.end(), bytes.begin(), encode_srgb);
-        ok = image_codec().write(path.string(), file, std::span<const uint8_t>(bytes), error);
+        ok = write_image_bytes(path.string(), file, std::span<const uint8_t>(bytes), error);
     }
     if (!ok) throw Error(fmt::format("cannot write image '{}': {}", path.string(), error));
 }

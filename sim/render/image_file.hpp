@@ -1,4 +1,5 @@
-// Writes a rendered framebuffer to disk through the image module (OpenImageIO).
+// Writes a rendered framebuffer to disk: a PNG with libpng, other formats through the image
+// module (OpenImageIO).
 #pragma once
 #include <cstdint>
 #include <filesystem>

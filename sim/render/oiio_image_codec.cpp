@@ -1,6 +1,5 @@
 // The image module (libtpsim_oiio.so): reads, writes, compares and annotates images with
 // OpenImageIO. Loaded on first use through image_codec() (image_codec.cpp).
-#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
@@ -73,19 +72,6 @@ public:
     bool write(const std::string& path, const ImageLayout& file, std::span<const uint8_t> pixels,
                std::string& error) const override {
         return write_pixels(path, file, OIIO::TypeDesc::UINT8, pixels.data(), error);
-    }
-
-    std::string encode_png(const ImageLayout& layout,
-                           std::span<const uint8_t> pixels) const override {
-        std::vector<unsigned char> out;
-        OIIO::Filesystem::IOVecOutput proxy(out);
-        auto writer = OIIO::ImageOutput::create("png");
-        if (!writer || !writer->set_ioproxy(&proxy) ||
-            !writer->open("image.png", OIIO::ImageSpec(layout.width, layout.height, layout.channels,
-                                                       OIIO::TypeDesc::UINT8)) ||
-            !writer->write_image(OIIO::TypeDesc::UINT8, pixels.data()) || !writer->close())
-            return {};
-        return std::string(out.begin(), out.end());
     }
 
     PixelDifference compare(const Image& a, const Image& b) const override {
