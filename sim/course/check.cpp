@@ -49,7 +49,7 @@ void write_rgb8(const std::filesystem::path& path, const Rgb8& image) {
     std::string error;
     if (!render::write_image_bytes(path.string(), layout, std::span<const uint8_t>(image.pixels),
                                    error))
-        throw Error(fmt::format("cannot write image '{}'", path.string()));
+        throw Error(fmt::format("cannot write image '{}': {}", path.string(), error));
 }
 
 /// Counts as a person reads them: 1,234,567 for large values, 3 digits for small ones.
@@ -346,18 +346,18 @@ CheckReport check(const Assignment& a, const CheckOptions& o) {
         const std::string stem = fmt::format("check-{}-{}", a.id, scene.name);
         const std::filesystem::path image_path =
             o.update_references ? scene.reference : o.output_dir / (stem + ".png");
-        render::write_image(image_path, result.rgb, result.scene.width, result.scene.height);
+        // 8-bit sRGB, as a render's PNG; compared from memory, so another check writing the
+        // same file name cannot change what this one compares.
+        Rgb8 image{int(result.scene.width), int(result.scene.height),
+                   std::vector<uint8_t>(result.rgb.size())};
+        std::transform(result.rgb.begin(), result.rgb.end(), image.pixels.begin(),
+                       render::encode_srgb);
+        write_rgb8(image_path, image);
         report.files.push_back(image_path);
         if (o.update_references) {
             report.results.push_back({scene.name, "image", true,
                                       fmt::format("reference written: {}", image_path.string())});
         } else {
-            // The pixels as written, from memory: another check writing the same file name
-            // cannot change what this one compares.
-            Rgb8 image{int(result.scene.width), int(result.scene.height),
-                       std::vector<uint8_t>(result.rgb.size())};
-            std::transform(result.rgb.begin(), result.rgb.end(), image.pixels.begin(),
-                           render::encode_srgb);
             Rgb8 ref = read_rgb8(scene.reference, "reference image");
             if (ref.width != image.width || ref.height != image.height)
                 throw Error(fmt::format("reference image {} is {}x{} but the assignment renders "
