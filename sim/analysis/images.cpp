@@ -29,7 +29,7 @@ std::optional<Image> read_pixels(const std::filesystem::path& path, std::string&
     }
     Image image;
     std::string why;
-    if (!render::image_codec().read(path.string(), render::PixelType::Float, image, why)) {
+    if (!render::read_image_file(path.string(), render::PixelType::Float, image, why)) {
         error = fmt::format("cannot read image {}: {}", path.string(), why);
         return std::nullopt;
     }

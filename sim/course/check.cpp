@@ -30,7 +30,7 @@ struct Rgb8 {
 Rgb8 read_rgb8(const std::filesystem::path& path, std::string_view what) {
     render::Image file;
     std::string error;
-    if (!render::image_codec().read(path.string(), render::PixelType::UInt8, file, error))
+    if (!render::read_image_file(path.string(), render::PixelType::UInt8, file, error))
         throw Error(fmt::format("cannot read {} {}: {}", what, path.string(), error));
     const int channels = file.layout.channels;
     if (channels < 3)

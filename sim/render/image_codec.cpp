@@ -11,6 +11,12 @@ const ImageCodec& image_codec() {
     return codec;
 }
 
+bool read_image_file(const std::string& path, PixelType in_memory, Image& image,
+                     std::string& error) {
+    return read_plain_png(path, in_memory, image) ||
+           image_codec().read(path, in_memory, image, error);
+}
+
 bool can_write_image(const std::string& path) {
     return is_png(path) || image_codec().can_write(path);
 }

@@ -76,6 +76,10 @@ protected:
 /// The image module, loaded on the first call; throws tpsim::Error if it cannot be loaded.
 const ImageCodec& image_codec();
 
+/// Reads an image as ImageCodec::read does: a plain PNG with libpng (png_file.hpp), without
+/// loading the image module; any other file through the module.
+bool read_image_file(const std::string& path, PixelType in_memory, Image& image,
+                     std::string& error);
 /// Whether an image can be written at `path` (its extension): a PNG always (png_file.hpp),
 /// another format if the image module has a writer for it.
 bool can_write_image(const std::string& path);

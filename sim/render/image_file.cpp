@@ -70,7 +70,7 @@ std::vector<float> read_image(const std::filesystem::path& path, uint32_t& width
                               uint32_t& height) {
     Image image;
     std::string error;
-    if (!image_codec().read(path.string(), PixelType::Float, image, error))
+    if (!read_image_file(path.string(), PixelType::Float, image, error))
         throw Error(fmt::format("cannot read image '{}': {}", path.string(), error));
     const ImageLayout& layout = image.layout;
     if (layout.channels < 3)

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <vector>
 
 namespace tpsim::render {
 namespace {
@@ -54,6 +55,34 @@ std::string encode_png(const ImageLayout& layout, std::span<const uint8_t> pixel
     }
     error = image.message;
     return {};
+}
+
+bool read_plain_png(const std::filesystem::path& path, PixelType in_memory, Image& image) {
+    png_image file{};
+    file.version = PNG_IMAGE_VERSION;
+    if (!png_image_begin_read_from_file(&file, path.c_str())) return false;
+    // Read as stored: anything libpng would convert (16 bits, alpha, a palette, a colour space
+    // other than sRGB) is left to the image module, which reads the values unconverted.
+    const bool plain = (file.format == PNG_FORMAT_GRAY || file.format == PNG_FORMAT_RGB) &&
+                       (file.flags & PNG_IMAGE_FLAG_COLORSPACE_NOT_sRGB) == 0;
+    const int channels = file.format == PNG_FORMAT_RGB ? 3 : 1;
+    std::vector<uint8_t> bytes(plain ? PNG_IMAGE_SIZE(file) : 0);
+    if (!plain || !png_image_finish_read(&file, nullptr, bytes.data(), 0, nullptr)) {
+        png_image_free(&file);
+        return false;
+    }
+    image.layout =
+        ImageLayout{int(file.width), int(file.height), channels, PixelType::UInt8, {}, {}};
+    if (in_memory == PixelType::Float) {
+        image.floats.resize(bytes.size());
+        std::transform(bytes.begin(), bytes.end(), image.floats.begin(),
+                       [](uint8_t b) { return float(b) / 255.f; });
+        image.bytes.clear();
+    } else {
+        image.bytes = std::move(bytes);
+        image.floats.clear();
+    }
+    return true;
 }
 
 bool write_png(const std::filesystem::path& path, const ImageLayout& layout,

@@ -1,6 +1,7 @@
 // PNG with libpng (sim/render/png_file.hpp): what it writes reads back through OpenImageIO pixel
-// for pixel, the same pixels give the same bytes, bad layouts and paths give reasons, and a
-// render's PNG is written without loading the image module.
+// for pixel, the same pixels give the same bytes, bad layouts and paths give reasons, a render's
+// PNG is written and a plain PNG read without loading the image module, and what libpng would
+// convert is left to the module.
 #include <fstream>
 #include <iterator>
 #include <numeric>
@@ -107,12 +108,63 @@ TEST_CASE("png: a render's PNG is checked and written without loading the image 
     for (float& v : rgb)
         v /= float(rgb.size());
     write_image(path, rgb, 4, 2);
-    CHECK_FALSE(image_module_loaded());
-    // Read back (through the module): the sRGB curve of each value.
+    // Read back: the sRGB curve of each value.
     uint32_t width = 0, height = 0;
     const std::vector<float> back = read_image(path, width, height);
-    CHECK(image_module_loaded());
     REQUIRE((width == 4 && height == 2));
     for (size_t i = 0; i < rgb.size(); ++i)
         CHECK(back[i] == Approx(float(encode_srgb(rgb[i])) / 255.f));
+    CHECK_FALSE(image_module_loaded());
+}
+
+TEST_CASE("png: a plain PNG reads back as stored without loading the image module") {
+    for (int channels : {1, 3}) {
+        CAPTURE(channels);
+        const ImageLayout layout{7, 2, channels, PixelType::UInt8, {}, {}};
+        const std::vector<uint8_t> pixels = pattern(layout);
+        const auto path = scratch(fmt::format("plain{}.png", channels));
+        std::string error;
+        REQUIRE(write_png(path, layout, pixels, error));
+        Image bytes, floats;
+        REQUIRE(read_image_file(path.string(), PixelType::UInt8, bytes, error));
+        REQUIRE(read_image_file(path.string(), PixelType::Float, floats, error));
+        CHECK((bytes.layout.width == 7 && bytes.layout.height == 2));
+        CHECK(bytes.layout.channels == channels);
+        CHECK(bytes.layout.type == PixelType::UInt8);
+        CHECK(bytes.bytes == pixels);
+        REQUIRE(floats.floats.size() == pixels.size());
+        for (size_t i = 0; i < pixels.size(); ++i)
+            CHECK(floats.floats[i] == float(pixels[i]) / 255.f);
+    }
+    CHECK_FALSE(image_module_loaded());
+}
+
+TEST_CASE("png: what libpng would convert is read by the image module, values as stored") {
+    // RGBA (libpng's simplified reader would keep the alpha apart; the module is the reference),
+    // and a PNG written by OpenImageIO (gAMA, cHRM and sRGB chunks: still read by libpng) whose
+    // values must equal the module's.
+    const ImageLayout rgba{3, 3, 4, PixelType::UInt8, {}, {}};
+    const auto rgba_path = scratch("rgba.png");
+    std::string error;
+    REQUIRE(write_png(rgba_path, rgba, pattern(rgba), error));
+    Image image;
+    CHECK_FALSE(read_plain_png(rgba_path, PixelType::UInt8, image));
+    CHECK(image.layout.width == 0);  // untouched
+    CHECK_FALSE(read_plain_png(scratch("missing.png"), PixelType::UInt8, image));
+
+    const ImageLayout rgb{4, 4, 3, PixelType::UInt8, {}, {}};
+    const std::vector<uint8_t> pixels = pattern(rgb);
+    const auto oiio_path = scratch("oiio.png");
+    auto out = OIIO::ImageOutput::create(oiio_path.string());
+    REQUIRE(out);
+    OIIO::ImageSpec spec(4, 4, 3, OIIO::TypeDesc::UINT8);
+    spec.attribute("oiio:ColorSpace", "sRGB");
+    REQUIRE(out->open(oiio_path.string(), spec));
+    REQUIRE(out->write_image(OIIO::TypeDesc::UINT8, pixels.data()));
+    REQUIRE(out->close());
+    REQUIRE(read_plain_png(oiio_path, PixelType::UInt8, image));
+    CHECK(image.bytes == pixels);
+    Image through_module;
+    REQUIRE(image_codec().read(oiio_path.string(), PixelType::UInt8, through_module, error));
+    CHECK(through_module.bytes == image.bytes);
 }
