@@ -1,7 +1,6 @@
 #include "sim/render/heatmap.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -9,6 +8,7 @@
 #include "sim/core/error.hpp"
 #include "sim/core/output_directory.hpp"
 #include "sim/render/image_codec.hpp"
+#include "sim/render/png_file.hpp"
 #include "sim/stats/thousands.hpp"
 
 namespace tpsim::render {
@@ -91,10 +91,7 @@ HeatMetric parse_heat_metric(std::string_view name) {
 }
 
 void check_heatmap_path(const std::filesystem::path& path) {
-    std::string extension = path.extension().string();
-    std::transform(extension.begin(), extension.end(), extension.begin(),
-                   [](unsigned char c) { return char(std::tolower(c)); });
-    if (extension != ".png")
+    if (!is_png(path))
         throw Error(fmt::format("cannot write heat map '{}': it is a PNG (its float EXR goes "
                                 "beside it); give a name ending in .png",
                                 path.string()));

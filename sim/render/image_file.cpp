@@ -9,15 +9,15 @@
 #include <fmt/format.h>
 
 #include "sim/core/error.hpp"
+#include "sim/core/file_extension.hpp"
 #include "sim/core/output_directory.hpp"
 #include "sim/render/image_codec.hpp"
 
 namespace tpsim::render {
 namespace {
 
-bool is_float_format(std::string extension) {
-    std::transform(extension.begin(), extension.end(), extension.begin(),
-                   [](unsigned char c) { return char(std::tolower(c)); });
+bool is_float_format(const std::filesystem::path& path) {
+    const std::string extension = lower_extension(path);
     return extension == ".exr" || extension == ".hdr" || extension == ".pfm" ||
            extension == ".tif" || extension == ".tiff";
 }
@@ -50,7 +50,7 @@ void check_image_path(const std::filesystem::path& path) {
 
 void write_image(const std::filesystem::path& path, std::span<const float> rgb, uint32_t width,
                  uint32_t height) {
-    const bool linear = is_float_format(path.extension().string());
+    const bool linear = is_float_format(path);
     const ImageLayout file{int(width), int(height),
                            3,          linear ? PixelType::Float : PixelType::UInt8,
                            {},         {{"oiio:ColorSpace", linear ? "linear" : "sRGB"}}};

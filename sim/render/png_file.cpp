@@ -3,12 +3,13 @@
 #include <png.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <memory>
 #include <vector>
+
+#include "sim/core/file_extension.hpp"
 
 namespace tpsim::render {
 namespace {
@@ -34,10 +35,7 @@ bool describe(const ImageLayout& layout, std::span<const uint8_t> pixels, png_im
 }  // namespace
 
 bool is_png(const std::filesystem::path& path) {
-    std::string extension = path.extension().string();
-    std::transform(extension.begin(), extension.end(), extension.begin(),
-                   [](unsigned char c) { return char(std::tolower(c)); });
-    return extension == ".png";
+    return lower_extension(path) == ".png";
 }
 
 std::string encode_png(const ImageLayout& layout, std::span<const uint8_t> pixels,

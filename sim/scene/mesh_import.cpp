@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "sim/core/error.hpp"
+#include "sim/core/file_extension.hpp"
 #include "sim/core/input_file.hpp"
 #include "sim/core/module.hpp"
 #include "sim/scene/mesh_reader.hpp"
@@ -30,13 +31,6 @@ constexpr int kMaxJsonNesting = 64;
 /// reader does not (see docs/scenes.md). Assimp reads many more, not all of them safely.
 constexpr std::string_view kMeshFormats[] = {".obj", ".ply", ".off", ".stl", ".gltf", ".glb"};
 constexpr std::string_view kMeshFormatList = ".obj, .ply, .off, .stl, .gltf or .glb";
-
-std::string lower_extension(const std::filesystem::path& path) {
-    std::string extension = path.extension().string();
-    std::transform(extension.begin(), extension.end(), extension.begin(),
-                   [](unsigned char c) { return std::tolower(c); });
-    return extension;
-}
 
 [[noreturn]] void malformed(const std::string& where, std::string_view format,
                             const std::string& why) {
