@@ -35,6 +35,14 @@ public:
     uint64_t position(uint32_t lane) const {
         return at_[lane].value.load(std::memory_order_relaxed);
     }
+    /// Whether every other lane has reached a position after `position` (wait_turn would not
+    /// wait).
+    bool passed(uint32_t lane, uint64_t position) const {
+        for (uint32_t other = 0; other < lanes_; ++other)
+            if (other != lane && at_[other].value.load(std::memory_order_acquire) <= position)
+                return false;
+        return true;
+    }
     /// Returns once every other lane has reached a position after `position`.
     void wait_turn(uint32_t lane, uint64_t position) const {
         for (uint32_t other = 0; other < lanes_; ++other) {

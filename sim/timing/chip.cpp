@@ -1,6 +1,7 @@
 #include "sim/timing/chip.hpp"
 
 #include "kernel/memory_map.hpp"
+#include "sim/core/lane_balance.hpp"
 #include "sim/core/ordered_turns.hpp"
 #include "sim/timing/bits.hpp"
 #include "sim/timing/epoch_cycles.hpp"
@@ -13,6 +14,7 @@
 #include <algorithm>
 #include <atomic>
 #include <bit>
+#include <chrono>
 #include <exception>
 #include <functional>
 #include <iterator>
@@ -72,6 +74,13 @@ template <class Queue> void move_to_back(Queue& to, Queue& from) {
     if (from.empty()) return;  // the usual case: not even a call into the deque
     to.insert(to.end(), std::make_move_iterator(from.begin()), std::make_move_iterator(from.end()));
     from.clear();
+}
+
+using HostClock = std::chrono::steady_clock;
+
+uint64_t nanoseconds_since(HostClock::time_point start) {
+    return uint64_t(
+        std::chrono::duration_cast<std::chrono::nanoseconds>(HostClock::now() - start).count());
 }
 
 /// Lowers `count` to `to` if it is above (several host threads may).
@@ -450,7 +459,7 @@ Chip::Chip(const ChipConfig& config, InstructionSource& source, const ChipLayout
 /// The TMs' host threads: lane 0 is the calling thread, lanes 1.. wait for work between runs.
 struct Chip::HostThreads {
     explicit HostThreads(uint32_t lanes)
-        : turns(lanes), lane(new Lane[lanes]), start(lanes), done(lanes) {
+        : turns(lanes), lane(new Lane[lanes]), seen(lanes), start(lanes), done(lanes) {
         for (uint32_t lane = 1; lane < lanes; ++lane)
             threads.emplace_back([this, lane] {
                 for (;;) {
@@ -493,13 +502,34 @@ struct Chip::HostThreads {
     struct alignas(core::kHostSpacing) Count {
         std::atomic<uint64_t> value{0};
     };
+    // Each lane also measures its host time in one stretch of kTimedEvery, ticking its TMs
+    // (less what it waited for turns) and running the shared parts (written by the lane, read
+    // by lane 0 to balance the lanes).
+    struct Busy {
+        std::atomic<uint64_t> tm_ns{0}, shared_ns{0};
+        uint64_t turn_ns = 0;  // the lane's own: waiting for turns, in every stretch
+    };
     struct alignas(core::kHostSpacing) Lane {
         Count ticked;  // publishes `progress`
         std::array<Progress, 2> progress;
+        Busy busy;
     };
+    static constexpr uint64_t kTimedEvery = 8;
     std::unique_ptr<Lane[]> lane;
     Count shared_taken, shared;
     Count lane_limit, shared_limit;
+    // Which TMs each lane ticks: lane l the block [bounds[l], bounds[l + 1]) (Chip::first_tm at
+    // first). Every kBalanceStretches stretches (over runs) lane 0 may resize the blocks
+    // (Chip::balance_lanes): every lane takes its block of next_bounds from stretch `switch_at`
+    // of the run on (the next run's first if this one ends before: `pending`), once every lane
+    // has ticked the stretch before. Only lane 0 reads the rest while the lanes run.
+    static constexpr uint64_t kBalanceStretches = 1024;
+    std::vector<uint32_t> bounds, next_bounds;
+    Count switch_at;
+    bool pending = false;
+    uint64_t stretches = 0;  // lane 0's, over runs
+    uint64_t moves = 0;
+    std::vector<std::pair<uint64_t, uint64_t>> seen;  // each lane's Busy at lane 0's last look
     // Between runs the lanes sleep (after a short spin: runs follow each other closely).
     core::SpinBarrier<> start, done;
     bool stop = false;
@@ -513,22 +543,74 @@ void Chip::use_host_threads(uint32_t threads) {
     lanes_ = lanes;
     if (layout_.profile) collect();  // the lanes' counts so far go on in lane 0
     host_threads_.reset();
-    if (lanes > 1) host_threads_ = std::make_unique<HostThreads>(lanes);
+    if (lanes > 1) {
+        host_threads_ = std::make_unique<HostThreads>(lanes);
+        for (uint32_t lane = 0; lane <= lanes; ++lane)
+            host_threads_->bounds.push_back(first_tm(lane, lanes));
+    }
     profile_lanes_.assign(layout_.profile ? lanes + 1 : 0, {});  // the last: the shared parts'
     for (ProfileLane& lane : profile_lanes_) {
         lane.profile.text = layout_.text;
         lane.profile.words.resize(profile_.words.size());
     }
     if (!profile_lanes_.empty()) profile_lanes_[0].profile.words = profile_.words;
+    // Between runs: every TM, idle or not, has its lane's profile (the old lanes are gone).
     for (uint32_t lane = 0; lane < lanes; ++lane)
-        for (uint32_t t = first_tm(lane, lanes); t < first_tm(lane + 1, lanes); ++t) {
-            Tm& tm = *tms_[t];
-            tm.lane = lane;
-            if (layout_.profile) {
-                tm.profile = &profile_lanes_[lane].profile;
-                tm.outside_text = &profile_lanes_[lane].outside_text;
-            }
-        }
+        for (uint32_t t = first_tm(lane, lanes); t < first_tm(lane + 1, lanes); ++t)
+            join_lane(*tms_[t], lane);
+}
+
+void Chip::join_lane(Tm& tm, uint32_t lane) {
+    tm.lane = lane;
+    if (layout_.profile) {
+        tm.profile = &profile_lanes_[lane].profile;
+        tm.outside_text = &profile_lanes_[lane].outside_text;
+    }
+}
+
+uint64_t Chip::lane_moves() const {
+    return host_threads_ ? host_threads_->moves : 0;
+}
+
+void Chip::take_tms(uint32_t lane, uint32_t from, uint32_t to) {
+    // A TM whose threads have all exited is the shared parts' (shared_stretch): not touched.
+    for (uint32_t t = from; t < to; ++t)
+        if (Tm& tm = *tms_[t]; tm.idle_from.load(std::memory_order_relaxed) == kNever)
+            join_lane(tm, lane);
+}
+
+void Chip::balance_lanes(uint64_t stretch) {
+    HostThreads& host = *host_threads_;
+    const uint32_t lanes = host.lanes();
+    // The last change must have reached every lane.
+    if (host.pending) return;
+    const uint64_t switched = host.switch_at.value.load(std::memory_order_relaxed);
+    if (switched != kNever)
+        for (uint32_t lane = 0; lane < lanes; ++lane)
+            if (host.lane[lane].ticked.value.load(std::memory_order_acquire) <= switched) return;
+    std::vector<core::LaneLoad> loads(lanes);
+    std::vector<bool> running(tms_.size());
+    for (uint32_t t = 0; t < tms_.size(); ++t)
+        running[t] = tms_[t]->idle_from.load(std::memory_order_relaxed) == kNever;
+    for (uint32_t lane = 0; lane < lanes; ++lane) {
+        const HostThreads::Busy& busy = host.lane[lane].busy;
+        const auto now = std::pair{busy.tm_ns.load(std::memory_order_relaxed),
+                                   busy.shared_ns.load(std::memory_order_relaxed)};
+        auto& [tm_ns, shared_ns] = host.seen[lane];
+        loads[lane] = {1e-9 * double(now.first - tm_ns),
+                       uint32_t(std::count(running.begin() + host.bounds[lane],
+                                           running.begin() + host.bounds[lane + 1], true)),
+                       1e-9 * double(now.second - shared_ns)};
+        host.seen[lane] = now;
+    }
+    // 2 %: what moving a TM's state to another core costs is paid back within the interval.
+    std::vector<uint32_t> bounds = core::balance_lanes(host.bounds, loads, running, 0.02);
+    if (bounds == host.bounds) return;
+    host.next_bounds = std::move(bounds);
+    host.pending = true;
+    // No lane has begun stretch + 3: a lane ticks stretch k only once the shared parts have
+    // run stretch k - 2, which waits for lane 0's stretch k - 2.
+    host.switch_at.value.store(stretch + 3, std::memory_order_release);
 }
 
 Chip::Chip(const ChipConfig& config, MachineSource& source, const ChipLayout& layout)
@@ -780,7 +862,8 @@ template <class Source> bool Chip::run_cycles(uint64_t end) {
         while (cycles_ < end && !finished_) {
             const uint64_t first = cycles_;
             const uint64_t stretch_end = std::min(end, first + lookahead_);
-            const Progress progress = tick_tms(0, 1, first, stretch_end, source);
+            const Progress progress =
+                tick_tms(0, 0, uint32_t(tms_.size()), first, stretch_end, source);
             shared_stretch(first, stretch_end, progress, source);
         }
     }
@@ -814,6 +897,10 @@ template <class Source> void Chip::run_pipelined(uint64_t end, Source& source) {
         host.lane[lane].ticked.value = 0;
     host.shared_taken.value = host.shared.value = 0;
     host.lane_limit.value = host.shared_limit.value = kNever;
+    host.switch_at.value = host.pending ? 0 : kNever;
+    const auto add_time = [](std::atomic<uint64_t>& sum, uint64_t ns) {
+        sum.store(sum.load(std::memory_order_relaxed) + ns, std::memory_order_relaxed);
+    };
     const uint32_t spins = core::spins_for(lanes);
     std::exception_ptr shared_error;
 
@@ -821,18 +908,21 @@ template <class Source> void Chip::run_pipelined(uint64_t end, Source& source) {
     // lane 0 after its TMs' stretch (their state stays in its core's caches), or a lane that
     // would otherwise wait for it (lane 0 carries the serial work on top of its TMs').
     // Returns whether it ran one.
-    const auto run_shared = [&] {
+    const auto run_shared = [&](uint32_t lane) {
         const uint64_t s = load(host.shared);
         if (begin(s) >= end || s >= load(host.shared_limit)) return false;
-        for (uint32_t lane = 0; lane < lanes; ++lane)
-            if (load(host.lane[lane].ticked) <= s) return false;
+        for (uint32_t l = 0; l < lanes; ++l)
+            if (load(host.lane[l].ticked) <= s) return false;
         uint64_t untaken = s;  // no lane has taken stretch s on (nor is running an earlier one)
         if (!host.shared_taken.value.compare_exchange_strong(untaken, s + 1)) return false;
         Progress progress;
-        for (uint32_t lane = 0; lane < lanes; ++lane)
-            progress.add(host.lane[lane].progress[s % 2]);
+        for (uint32_t l = 0; l < lanes; ++l)
+            progress.add(host.lane[l].progress[s % 2]);
+        const bool timed = s % HostThreads::kTimedEvery == 0;
+        const HostClock::time_point start = timed ? HostClock::now() : HostClock::time_point{};
         try {
             shared_stretch(begin(s), finish(s), progress, source);
+            if (timed) add_time(host.lane[lane].busy.shared_ns, nanoseconds_since(start));
         } catch (...) {  // nothing from stretch s on counts: the lanes stop
             shared_error = std::current_exception();
             lower(host.lane_limit.value, s);
@@ -847,23 +937,57 @@ template <class Source> void Chip::run_pipelined(uint64_t end, Source& source) {
         return true;
     };
     const auto lane_work = [&](uint32_t lane) {
+        uint32_t from = host.bounds[lane], to = host.bounds[lane + 1];
         for (uint64_t k = 0; begin(k) < end; ++k) {
             // Stretch k receives what the shared parts' stretch k - lag - 1 decided.
             const auto may_tick = [&] {
                 return load(host.shared) + lag >= k || k >= load(host.lane_limit);
             };
-            core::spin_until([&] { return may_tick() || (run_shared() && may_tick()); }, spins);
+            core::spin_until([&] { return may_tick() || (run_shared(lane) && may_tick()); }, spins);
+            // New blocks from this stretch on: each lane's TMs must have left stretch k - 1
+            // behind first.
+            const bool new_blocks = k == load(host.switch_at);
+            const auto all_ticked = [&] {
+                for (uint32_t l = 0; l < lanes; ++l)
+                    if (load(host.lane[l].ticked) < k) return false;
+                return true;
+            };
+            if (new_blocks)
+                core::spin_until(
+                    [&] {
+                        if (all_ticked() || k >= load(host.lane_limit)) return true;
+                        run_shared(lane);
+                        return false;
+                    },
+                    spins);
             if (k >= load(host.lane_limit)) {  // stopped early: other lanes' steps wait no more
                 host.turns.reach(lane, core::OrderedTurns::kDone);
                 break;
             }
-            if (!tick_lane(lane, k, begin(k), finish(k), source)) break;
-            if (lane == 0) run_shared();
+            if (new_blocks) {
+                from = host.next_bounds[lane], to = host.next_bounds[lane + 1];
+                take_tms(lane, from, to);
+                if (lane == 0) {
+                    host.bounds = host.next_bounds;
+                    host.pending = false;
+                    ++host.moves;
+                }
+            }
+            HostThreads::Busy& busy = host.lane[lane].busy;
+            const bool timed = k % HostThreads::kTimedEvery == 0;
+            const HostClock::time_point start = timed ? HostClock::now() : HostClock::time_point{};
+            const uint64_t waited = busy.turn_ns;
+            if (!tick_lane(lane, from, to, k, begin(k), finish(k), source)) break;
+            if (timed) add_time(busy.tm_ns, nanoseconds_since(start) - (busy.turn_ns - waited));
+            if (lane == 0) {
+                run_shared(lane);
+                if (++host.stretches % HostThreads::kBalanceStretches == 0) balance_lanes(k);
+            }
         }
         // The shared parts' stretches left, on whichever lanes come for them.
         core::spin_until(
             [&] {
-                run_shared();
+                run_shared(lane);
                 const uint64_t s = load(host.shared);
                 return begin(s) >= end || s >= load(host.shared_limit);
             },
@@ -953,10 +1077,9 @@ void Chip::deliver() {
 }
 
 template <class Source>
-Chip::Progress Chip::tick_tms(uint32_t lane, uint32_t lanes, uint64_t first, uint64_t end,
-                              Source& source) {
+Chip::Progress Chip::tick_tms(uint32_t lane, uint32_t from, uint32_t to, uint64_t first,
+                              uint64_t end, Source& source) {
     const uint64_t tms = tms_.size();
-    const uint32_t from = first_tm(lane, lanes), to = first_tm(lane + 1, lanes);
     // Each TM ticks the stretch's cycles in a row, its state hot in the host's caches, until a
     // thread's next instruction is not private: from that cycle on, the TM ticks in the order
     // (cycle, TM), where steps other threads can see must happen. A fault on the way is raised
@@ -998,11 +1121,11 @@ Chip::Progress Chip::tick_tms(uint32_t lane, uint32_t lanes, uint64_t first, uin
 }
 
 template <class Source>
-bool Chip::tick_lane(uint32_t lane, uint64_t stretch, uint64_t first, uint64_t end,
-                     Source& source) {
+bool Chip::tick_lane(uint32_t lane, uint32_t from, uint32_t to, uint64_t stretch, uint64_t first,
+                     uint64_t end, Source& source) {
     HostThreads& host = *host_threads_;
     try {
-        host.lane[lane].progress[stretch % 2] = tick_tms(lane, host.lanes(), first, end, source);
+        host.lane[lane].progress[stretch % 2] = tick_tms(lane, from, to, first, end, source);
         host.lane[lane].ticked.value.store(stretch + 1, std::memory_order_release);
         return true;
     } catch (const core::OrderedTurns::Abandoned&) {
@@ -1034,7 +1157,11 @@ bool Chip::tick_lane(uint32_t lane, uint64_t stretch, uint64_t first, uint64_t e
 void Chip::wait_turn(const Tm& tm, uint64_t now) {
     HostThreads& host = *host_threads_;
     const uint64_t position = now * tms_.size() + tm.id;
-    host.turns.wait_turn(tm.lane, position);
+    if (!host.turns.passed(tm.lane, position)) {  // the time waited is not the lane's work
+        const HostClock::time_point start = HostClock::now();
+        host.turns.wait_turn(tm.lane, position);
+        host.lane[tm.lane].busy.turn_ns += nanoseconds_since(start);
+    }
     if (host.first_failure.load() < position) throw core::OrderedTurns::Abandoned{};
 }
 

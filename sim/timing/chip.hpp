@@ -76,6 +76,9 @@ public:
     /// Simulates the TMs on up to `threads` host threads (at most one per TM; 1: on the calling
     /// thread only). Nothing the chip reports depends on it.
     void use_host_threads(uint32_t threads);
+    /// Times the host threads' blocks of TMs were resized to balance their work since
+    /// use_host_threads() last changed their number.
+    uint64_t lane_moves() const;
 
     /// How often callers looping over run_until() usually report progress.
     static constexpr uint64_t kProgressInterval = 1 << 16;
@@ -191,17 +194,27 @@ private:
     /// run_cycles() on the host threads: stretches of TM ticks on every lane, the shared parts'
     /// stretches a stretch or two behind, on lane 0 or a lane that would wait for them.
     template <class Source> void run_pipelined(uint64_t end, Source& source);
-    /// The TMs of host thread `lane` of `lanes` (first_tm) tick cycles [first, end): they take
-    /// their mail first and hand over what they sent after. Returns their progress.
+    /// TMs [from, to), host thread `lane`'s, tick cycles [first, end): they take their mail
+    /// first and hand over what they sent after. Returns their progress.
     template <class Source>
-    Progress tick_tms(uint32_t lane, uint32_t lanes, uint64_t first, uint64_t end, Source& source);
+    Progress tick_tms(uint32_t lane, uint32_t from, uint32_t to, uint64_t first, uint64_t end,
+                      Source& source);
     /// tick_tms() of stretch `stretch` on a lane of run_pipelined(); false if it failed or
     /// stopped at another lane's earlier failure (recorded in HostThreads).
     template <class Source>
-    bool tick_lane(uint32_t lane, uint64_t stretch, uint64_t first, uint64_t end, Source& source);
-    /// The TMs host thread `lane` of `lanes` ticks are [first_tm(lane), first_tm(lane + 1)):
-    /// blocks of consecutive ids, so that two host threads' TMs are neighbours in memory only
-    /// at the blocks' ends.
+    bool tick_lane(uint32_t lane, uint32_t from, uint32_t to, uint64_t stretch, uint64_t first,
+                   uint64_t end, Source& source);
+    /// Lane 0 of run_pipelined() after stretch `stretch`: resizes the lanes' blocks of TMs from
+    /// stretch + 3 on if their measured host time says so (core::balance_lanes).
+    void balance_lanes(uint64_t stretch);
+    /// Host thread `lane` ticks TMs [from, to) from now on, those still running (the shared
+    /// parts tick the others).
+    void take_tms(uint32_t lane, uint32_t from, uint32_t to);
+    /// TM `tm` is host thread `lane`'s: its turns and its profile counts.
+    void join_lane(Tm& tm, uint32_t lane);
+    /// The TMs host thread `lane` of `lanes` ticks at first are [first_tm(lane),
+    /// first_tm(lane + 1)): blocks of consecutive ids, so that two host threads' TMs are
+    /// neighbours in memory only at the blocks' ends. The blocks are resized as the run goes.
     uint32_t first_tm(uint32_t lane, uint32_t lanes) const {
         return uint32_t(uint64_t{tms_.size()} * lane / lanes);
     }

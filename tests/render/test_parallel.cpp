@@ -15,6 +15,7 @@
 #include "sim/core/error.hpp"
 #include "sim/core/fault.hpp"
 #include "sim/core/host_threads.hpp"
+#include "sim/core/lane_balance.hpp"
 #include "sim/core/ordered_turns.hpp"
 #include "sim/core/spin_wait.hpp"
 #include "sim/render/render.hpp"
@@ -127,6 +128,48 @@ TEST_CASE("ordered turns: actions at increasing positions run in position order 
         CHECK(log.size() > kPositions / 5);
         CHECK(std::is_sorted(log.begin(), log.end()));
     }
+}
+
+TEST_CASE("lane balance: the lanes' blocks of TMs follow their measured time per TM",
+          "[parallel]") {
+    using core::LaneLoad;
+    const std::vector<uint32_t> halves = {0, 8, 16};
+    const std::vector<bool> all(16, true);
+    // Equal lanes stay as they are; so does a difference within the least gain asked for.
+    CHECK(core::balance_lanes(halves, std::vector<LaneLoad>{{8, 8, 0}, {8, 8, 0}}, all, 0.02) ==
+          halves);
+    CHECK(core::balance_lanes(halves, std::vector<LaneLoad>{{8.1, 8, 0}, {8, 8, 0}}, all, 0.02) ==
+          halves);
+    // A lane twice as slow per TM gets a third of them: 5 TMs at 2 against 11 at 1 (the busiest
+    // lane 11 instead of 16).
+    CHECK(core::balance_lanes(halves, std::vector<LaneLoad>{{8, 8, 0}, {16, 8, 0}}, all, 0.02) ==
+          std::vector<uint32_t>{0, 11, 16});
+    // Serial work on lane 0 (the shared parts, 2 TMs' worth) leaves it fewer TMs.
+    CHECK(core::balance_lanes(halves, std::vector<LaneLoad>{{8, 8, 2}, {8, 8, 0}}, all, 0.02) ==
+          std::vector<uint32_t>{0, 7, 16});
+    // Idle TMs cost nothing and stay with the block before them: TMs 0-3 and 12 running,
+    // lane 0 has four at 1 s each, lane 1 one: three and two (TM 3 and idle 4-11 go to lane 1).
+    std::vector<bool> running(16, false);
+    for (uint32_t t : {0, 1, 2, 3, 12})
+        running[t] = true;
+    CHECK(core::balance_lanes(halves, std::vector<LaneLoad>{{4, 4, 0}, {1, 1, 0}}, running, 0.02) ==
+          std::vector<uint32_t>{0, 3, 16});
+    // A lane with no running TM is taken to be as fast as the others.
+    running[12] = false;
+    CHECK(core::balance_lanes(halves, std::vector<LaneLoad>{{4, 4, 0}, {0, 0, 0}}, running, 0.02) ==
+          std::vector<uint32_t>{0, 2, 16});
+    // Three lanes, the middle one three times as slow: the busiest lane's time is 6 (e.g. 5, 2
+    // and 5 TMs) instead of 12.
+    const std::vector<uint32_t> thirds = core::balance_lanes(
+        std::vector<uint32_t>{0, 4, 8, 12}, std::vector<LaneLoad>{{4, 4, 0}, {12, 4, 0}, {4, 4, 0}},
+        std::vector<bool>(12, true), 0.02);
+    REQUIRE(thirds.size() == 4);
+    CHECK(thirds.front() == 0);
+    CHECK(thirds.back() == 12);
+    CHECK(std::max({thirds[1] - thirds[0], 3 * (thirds[2] - thirds[1]), thirds[3] - thirds[2]}) ==
+          6);
+    // Nothing measured: no change.
+    CHECK(core::balance_lanes(halves, std::vector<LaneLoad>(2), all, 0.02) == halves);
 }
 
 TEST_CASE("spin barrier: each completion sees every thread's phase, and only then do they go on",

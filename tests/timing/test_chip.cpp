@@ -6,6 +6,7 @@
 #include "tests/timing/small_chips.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <deque>
 #include <regex>
 #include <sstream>
@@ -307,4 +308,55 @@ TEST_CASE("a fault in a private step is raised in its turn of the order (cycle, 
         CHECK(s.steps(0) == 5);
         CHECK(s.steps(1) == 4);
     }
+}
+
+TEST_CASE("TMs moved between host threads to balance their work give the same results",
+          "[chip][parallel]") {
+    // The steps of TMs 4-7 cost the host ~2 us each, those of TMs 0-3 nothing: the host thread
+    // ticking TMs 4-7 is far busier, so the chip hands TMs to the other as it runs
+    // (Chip::lane_moves). No step is private, so every step happens in its turn of the order
+    // (cycle, TM): the order of the steps and every statistic are those of one host thread.
+    struct SlowScript : Script {
+        SlowScript(uint32_t threads, uint32_t slow_from) : Script(threads), slow_from(slow_from) {}
+        void step(uint32_t thread, StepInfo& out) override {
+            order.push_back(thread);
+            if (thread >= slow_from) {
+                const auto until = std::chrono::steady_clock::now() + std::chrono::microseconds(2);
+                while (std::chrono::steady_clock::now() < until) {
+                }
+            }
+            Script::step(thread, out);
+        }
+        uint32_t slow_from;
+        std::vector<uint32_t> order;
+    };
+    const auto run = [](uint32_t host_threads, uint64_t& moves) {
+        ChipConfig c = one_tp();
+        c.chip.num_tms = 8;
+        c.chip.tms_per_l2 = 4;
+        SlowScript s(8, 4);
+        for (uint32_t t = 0; t < 8; ++t)
+            for (uint32_t i = 0; i < 8000; ++i)
+                if (i % 8 == 0)  // loads from lines of their own: traffic to the L2s and DRAM
+                    s.add(t, Op::lw, x(5 + i % 3), x(1), isa::kNoReg, 0x100000 * (t + 1) + 4 * i);
+                else
+                    s.add(t, Op::add, x(5 + i % 3), x(1), x(2));
+        s.finish();
+        Chip chip(c, s);
+        stats::Registry r;
+        chip.register_stats(r);
+        chip.use_host_threads(host_threads);
+        chip.run();
+        moves = chip.lane_moves();
+        std::ostringstream out;
+        out << stats::values_json(stats::Snapshot(r)).dump(1) << '\n';
+        for (uint32_t thread : s.order)
+            out << thread << ' ';
+        return out.str();
+    };
+    uint64_t moves = 0;
+    const std::string one = run(1, moves);
+    CHECK(moves == 0);
+    CHECK(run(2, moves) == one);
+    CHECK(moves > 0);
 }
