@@ -13,6 +13,7 @@
 #include "sim/core/error.hpp"
 #include "sim/render/image_codec.hpp"
 #include "sim/render/png_file.hpp"
+#include "sim/render/srgb.hpp"
 
 namespace tpsim::analysis {
 namespace {
@@ -63,7 +64,7 @@ ImageDifference compare_images(const std::filesystem::path& a, const std::filesy
 
 std::string png_bytes(const std::filesystem::path& path) {
     std::string error;
-    if (path.extension() == ".png") {
+    if (render::is_png(path)) {
         std::ifstream in(path, std::ios::binary);
         std::ostringstream bytes;
         bytes << in.rdbuf();
@@ -75,9 +76,9 @@ std::string png_bytes(const std::filesystem::path& path) {
     const bool linear = pixels->layout.type == render::PixelType::Float;
     std::vector<uint8_t> encoded(pixels->floats.size());
     for (size_t i = 0; i < encoded.size(); ++i) {
-        float v = std::clamp(pixels->floats[i], 0.0f, 1.0f);
-        if (linear) v = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1 / 2.4f) - 0.055f;
-        encoded[i] = static_cast<uint8_t>(std::lround(v * 255));
+        const float v = pixels->floats[i];
+        encoded[i] =
+            linear ? render::encode_srgb(v) : uint8_t(std::lround(std::clamp(v, 0.0f, 1.0f) * 255));
     }
     std::string png = render::encode_png(pixels->layout, encoded, error);
     if (png.empty())

@@ -12,7 +12,7 @@
 #include "sim/core/error.hpp"
 #include "sim/core/fault.hpp"
 #include "sim/render/image_codec.hpp"
-#include "sim/render/image_file.hpp"
+#include "sim/render/srgb.hpp"
 #include "sim/render/report.hpp"
 #include "sim/stats/registry.hpp"
 #include "sim/stats/thousands.hpp"

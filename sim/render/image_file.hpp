@@ -14,11 +14,6 @@ namespace tpsim::render {
 void write_image(const std::filesystem::path& path, std::span<const float> rgb, uint32_t width,
                  uint32_t height);
 
-/// The sRGB transfer curve (IEC 61966-2-1) of the 8-bit formats: linear [0, 1] to 8 bits
-/// (clamped; NaN is black), and back.
-uint8_t encode_srgb(float linear);
-float decode_srgb(uint8_t value);
-
 /// Throws tpsim::Error unless an image could be written at `path`: a known image extension and
 /// an existing directory. Called before a render so a long run cannot end in a bad path.
 void check_image_path(const std::filesystem::path& path);

@@ -1,5 +1,6 @@
 // The HTML pages as text: what they embed. (That their charts draw is checked in a headless
 // browser, see CMakeLists.txt.)
+#include <cmath>
 #include <fstream>
 #include <string>
 
@@ -111,13 +112,14 @@ TEST_CASE("report: text from the file cannot inject markup or end the data blob"
     CHECK(blob.at("charts").at(0).at("title") == "</script><i>");
 }
 
-TEST_CASE("report: a float image is embedded as an sRGB PNG", "[analysis]") {
+TEST_CASE("report: a float image is embedded as an sRGB PNG, as render writes it", "[analysis]") {
     const std::filesystem::path dir = std::filesystem::temp_directory_path() / "tpsim_report_img";
     std::filesystem::create_directories(dir);
-    const float linear[] = {0.5f, 0.0f, 1.0f};
+    // The second pixel: a NaN (black, as render writes it), below 0 and above 1 (clamped).
+    const float linear[] = {0.5f, 0.0f, 1.0f, std::nanf(""), -1.0f, 2.0f};
     auto out = OIIO::ImageOutput::create((dir / "one.exr").string());
     REQUIRE(out);
-    REQUIRE(out->open((dir / "one.exr").string(), OIIO::ImageSpec(1, 1, 3, OIIO::TypeDesc::FLOAT)));
+    REQUIRE(out->open((dir / "one.exr").string(), OIIO::ImageSpec(2, 1, 3, OIIO::TypeDesc::FLOAT)));
     REQUIRE(out->write_image(OIIO::TypeDesc::FLOAT, linear));
     REQUIRE(out->close());
     const std::string png = png_bytes(dir / "one.exr");
@@ -125,11 +127,14 @@ TEST_CASE("report: a float image is embedded as an sRGB PNG", "[analysis]") {
     std::ofstream(dir / "back.png", std::ios::binary) << png;
     auto in = OIIO::ImageInput::open((dir / "back.png").string());
     REQUIRE(in);
-    unsigned char rgb[3];
+    unsigned char rgb[6];
     REQUIRE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, rgb));
     CHECK(int(rgb[0]) == 188);  // sRGB(0.5) = 0.7354 -> 188
     CHECK(int(rgb[1]) == 0);
     CHECK(int(rgb[2]) == 255);
+    CHECK(int(rgb[3]) == 0);
+    CHECK(int(rgb[4]) == 0);
+    CHECK(int(rgb[5]) == 255);
     // An image that cannot be read leaves a note; the rest of the page is still written.
     std::ofstream(dir / "broken.exr") << "not an image";
     const StatsFile run = parse_stats_file(

@@ -14,6 +14,7 @@
 
 #include "sim/render/image_file.hpp"
 #include "sim/render/png_file.hpp"
+#include "sim/render/srgb.hpp"
 
 using namespace tpsim::render;
 
