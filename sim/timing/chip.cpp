@@ -542,8 +542,9 @@ void Chip::use_host_threads(uint32_t threads) {
     if (lanes == lanes_) return;
     lanes_ = lanes;
     if (layout_.profile) collect();  // the lanes' counts so far go on in lane 0
-    host_threads_.reset();
-    if (lanes > 1) {
+    // An unset --threads alternates between one host thread and all (render::run_timing): the
+    // host threads, with their blocks of TMs as balanced so far, wait through the runs on one.
+    if (lanes > 1 && !(host_threads_ && host_threads_->lanes() == lanes)) {
         host_threads_ = std::make_unique<HostThreads>(lanes);
         for (uint32_t lane = 0; lane <= lanes; ++lane)
             host_threads_->bounds.push_back(first_tm(lane, lanes));
@@ -556,7 +557,9 @@ void Chip::use_host_threads(uint32_t threads) {
     if (!profile_lanes_.empty()) profile_lanes_[0].profile.words = profile_.words;
     // Between runs: every TM, idle or not, has its lane's profile (the old lanes are gone).
     for (uint32_t lane = 0; lane < lanes; ++lane)
-        for (uint32_t t = first_tm(lane, lanes); t < first_tm(lane + 1, lanes); ++t)
+        for (uint32_t t = lanes > 1 ? host_threads_->bounds[lane] : 0,
+                      to = lanes > 1 ? host_threads_->bounds[lane + 1] : uint32_t(tms_.size());
+             t < to; ++t)
             join_lane(*tms_[t], lane);
 }
 
@@ -856,7 +859,7 @@ template <class Source> bool Chip::run_cycles(uint64_t end) {
     // A short run (drain() runs one cycle at a time) is not worth waking the host threads;
     // either way gives the same result.
     constexpr uint64_t kShortestParallelRun = 256;
-    if (host_threads_ && end >= cycles_ + kShortestParallelRun && !finished_) {
+    if (lanes_ > 1 && end >= cycles_ + kShortestParallelRun && !finished_) {
         run_pipelined(end, source);
     } else {
         while (cycles_ < end && !finished_) {

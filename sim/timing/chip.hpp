@@ -76,8 +76,8 @@ public:
     /// Simulates the TMs on up to `threads` host threads (at most one per TM; 1: on the calling
     /// thread only). Nothing the chip reports depends on it.
     void use_host_threads(uint32_t threads);
-    /// Times the host threads' blocks of TMs were resized to balance their work since
-    /// use_host_threads() last changed their number.
+    /// Times the host threads' blocks of TMs were resized to balance their work, over the runs
+    /// on the number of host threads last set above one.
     uint64_t lane_moves() const;
 
     /// How often callers looping over run_until() usually report progress.
