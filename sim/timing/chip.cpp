@@ -520,7 +520,7 @@ struct Chip::HostThreads {
     Count lane_limit, shared_limit;
     // Which TMs each lane ticks: lane l the block [bounds[l], bounds[l + 1]) (Chip::first_tm at
     // first). Every kBalanceStretches stretches (over runs) lane 0 may resize the blocks
-    // (Chip::balance_lanes): every lane takes its block of next_bounds from stretch `switch_at`
+    // (Chip::resize_blocks): every lane takes its block of next_bounds from stretch `switch_at`
     // of the run on (the next run's first if this one ends before: `pending`), once every lane
     // has ticked the stretch before. Only lane 0 reads the rest while the lanes run.
     static constexpr uint64_t kBalanceStretches = 1024;
@@ -582,7 +582,7 @@ void Chip::take_tms(uint32_t lane, uint32_t from, uint32_t to) {
             join_lane(tm, lane);
 }
 
-void Chip::balance_lanes(uint64_t stretch) {
+void Chip::resize_blocks(uint64_t stretch) {
     HostThreads& host = *host_threads_;
     const uint32_t lanes = host.lanes();
     // The last change must have reached every lane.
@@ -984,7 +984,7 @@ template <class Source> void Chip::run_pipelined(uint64_t end, Source& source) {
             if (timed) add_time(busy.tm_ns, nanoseconds_since(start) - (busy.turn_ns - waited));
             if (lane == 0) {
                 run_shared(lane);
-                if (++host.stretches % HostThreads::kBalanceStretches == 0) balance_lanes(k);
+                if (++host.stretches % HostThreads::kBalanceStretches == 0) resize_blocks(k);
             }
         }
         // The shared parts' stretches left, on whichever lanes come for them.

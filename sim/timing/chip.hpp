@@ -206,7 +206,7 @@ private:
                    uint64_t end, Source& source);
     /// Lane 0 of run_pipelined() after stretch `stretch`: resizes the lanes' blocks of TMs from
     /// stretch + 3 on if their measured host time says so (core::balance_lanes).
-    void balance_lanes(uint64_t stretch);
+    void resize_blocks(uint64_t stretch);
     /// Host thread `lane` ticks TMs [from, to) from now on, those still running (the shared
     /// parts tick the others).
     void take_tms(uint32_t lane, uint32_t from, uint32_t to);
