@@ -43,14 +43,10 @@ public:
                 return false;
         return true;
     }
-    /// Returns once every other lane has reached a position after `position`.
+    /// Returns once every other lane has reached a position after `position`. (The other lanes
+    /// are usually a few steps behind: spin_until.)
     void wait_turn(uint32_t lane, uint64_t position) const {
-        for (uint32_t other = 0; other < lanes_; ++other) {
-            if (other == lane) continue;
-            // The other lane is usually a few steps behind (spin_until).
-            spin_until([&] { return at_[other].value.load(std::memory_order_acquire) > position; },
-                       spins_);
-        }
+        spin_until([&] { return passed(lane, position); }, spins_);
     }
 
 private:

@@ -1,7 +1,6 @@
 #include "sim/render/image_file.hpp"
 
 #include <algorithm>
-#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>

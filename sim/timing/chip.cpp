@@ -556,10 +556,10 @@ void Chip::use_host_threads(uint32_t threads) {
     }
     if (!profile_lanes_.empty()) profile_lanes_[0].profile.words = profile_.words;
     // Between runs: every TM, idle or not, has its lane's profile (the old lanes are gone).
+    const std::vector<uint32_t> bounds =
+        lanes > 1 ? host_threads_->bounds : std::vector<uint32_t>{0, uint32_t(tms_.size())};
     for (uint32_t lane = 0; lane < lanes; ++lane)
-        for (uint32_t t = lanes > 1 ? host_threads_->bounds[lane] : 0,
-                      to = lanes > 1 ? host_threads_->bounds[lane + 1] : uint32_t(tms_.size());
-             t < to; ++t)
+        for (uint32_t t = bounds[lane]; t < bounds[lane + 1]; ++t)
             join_lane(*tms_[t], lane);
 }
 
