@@ -9,6 +9,7 @@
 #include <catch2/catch.hpp>
 
 #include "sim/analysis/compare.hpp"
+#include "tests/scratch.hpp"
 
 using namespace tpsim::analysis;
 
@@ -294,8 +295,7 @@ TEST_CASE("compare: JSON output parses back to the same figures", "[analysis]") 
 }
 
 TEST_CASE("compare: images are compared pixel by pixel", "[analysis]") {
-    const std::filesystem::path dir = std::filesystem::temp_directory_path() / "tpsim_compare_img";
-    std::filesystem::create_directories(dir);
+    const std::filesystem::path dir = tpsim::testing::fresh_scratch_dir("images");
     std::vector<unsigned char> a(4 * 4 * 3, 100), b = a;
     b[0] = 200;        // pixel 0: one channel off by 100/255
     b[3 * 5 + 2] = 0;  // pixel 5: one channel off by 100/255

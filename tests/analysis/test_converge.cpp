@@ -7,6 +7,7 @@
 
 #include "sim/analysis/converge.hpp"
 #include "sim/core/error.hpp"
+#include "tests/scratch.hpp"
 
 using namespace tpsim;
 using namespace tpsim::analysis;
@@ -28,17 +29,10 @@ ConvergeOptions small_options(const std::filesystem::path& dir) {
     return o;
 }
 
-std::filesystem::path fresh_dir(const char* name) {
-    const std::filesystem::path dir = std::filesystem::temp_directory_path() / name;
-    std::filesystem::remove_all(dir);
-    std::filesystem::create_directories(dir);
-    return dir;
-}
-
 }  // namespace
 
 TEST_CASE("converge: runs in order, each measured against the reference", "[analysis][converge]") {
-    const std::filesystem::path dir = fresh_dir("tpsim_converge_runs");
+    const std::filesystem::path dir = tpsim::testing::fresh_scratch_dir("runs");
     const ConvergeOptions o = small_options(dir);
     size_t reports = 0;
     const ConvergeResult r = converge(o, [&](const ConvergeResult& so_far) {
@@ -105,7 +99,7 @@ TEST_CASE("converge: runs in order, each measured against the reference", "[anal
 
 TEST_CASE("converge: options that cannot measure are refused before any render",
           "[analysis][converge]") {
-    const std::filesystem::path dir = fresh_dir("tpsim_converge_refused");
+    const std::filesystem::path dir = tpsim::testing::fresh_scratch_dir("refused");
     ConvergeOptions o = small_options(dir);
     o.reference_spp = 8;
     CHECK_THROWS_WITH(converge(o), "the reference (8 spp, --reference-spp) must take more "

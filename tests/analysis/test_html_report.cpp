@@ -8,6 +8,7 @@
 #include <catch2/catch.hpp>
 
 #include "sim/analysis/html_report.hpp"
+#include "tests/scratch.hpp"
 
 using namespace tpsim::analysis;
 
@@ -113,8 +114,7 @@ TEST_CASE("report: text from the file cannot inject markup or end the data blob"
 }
 
 TEST_CASE("report: a float image is embedded as an sRGB PNG, as render writes it", "[analysis]") {
-    const std::filesystem::path dir = std::filesystem::temp_directory_path() / "tpsim_report_img";
-    std::filesystem::create_directories(dir);
+    const std::filesystem::path dir = tpsim::testing::fresh_scratch_dir("images");
     // The second pixel: a NaN (black, as render writes it), below 0 and above 1 (clamped).
     const float linear[] = {0.5f, 0.0f, 1.0f, std::nanf(""), -1.0f, 2.0f};
     auto out = OIIO::ImageOutput::create((dir / "one.exr").string());

@@ -8,6 +8,7 @@
 #include "sim/analysis/stats_file.hpp"
 #include "sim/core/error.hpp"
 #include "sim/render/profile.hpp"
+#include "tests/scratch.hpp"
 
 using namespace tpsim;
 using namespace tpsim::analysis;
@@ -137,13 +138,12 @@ TEST_CASE("stats file: missing, directory and oversized files are named", "[anal
                                     ": it is a directory; give a file written by tpsim render "
                                     "--stats-json");
     // A sparse file: huge to stat, nothing written to disk.
-    const std::filesystem::path huge = std::filesystem::temp_directory_path() / "tpsim_huge.json";
+    const std::filesystem::path huge = tpsim::testing::scratch_path("huge.json");
     std::ofstream(huge).put('{');
     std::filesystem::resize_file(huge, kMaxStatsFileBytes + 1);
     CHECK(message(huge) == huge.string() + " is not a tpsim statistics file: 257 MiB, more than "
                                            "the 256 MiB this tpsim reads; give a file written by "
                                            "tpsim render --stats-json");
-    std::filesystem::remove(huge);
 }
 
 TEST_CASE("stats file: the profile the renderer writes reads back field for field", "[analysis]") {

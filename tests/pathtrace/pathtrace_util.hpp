@@ -6,9 +6,8 @@
 #include <string>
 #include <vector>
 
-#include <unistd.h>
-
 #include "sim/render/render.hpp"
+#include "tests/scratch.hpp"
 
 namespace tpsim::pathtrace_test {
 
@@ -27,13 +26,11 @@ inline std::filesystem::path cornell() {
     return std::filesystem::path(TPSIM_SOURCE_DIR) / "scenes" / "cornell.toml";
 }
 
-/// A scene file in a per-process scratch directory (parallel ctest runs do not collide).
+/// A scene file in the test's scratch directory.
 inline std::filesystem::path write_scene(const std::string& name, const std::string& contents) {
-    const auto dir = std::filesystem::temp_directory_path() /
-                     ("tpsim_pathtrace_test_" + std::to_string(getpid()));
-    std::filesystem::create_directories(dir);
-    std::ofstream(dir / name, std::ios::binary) << contents;
-    return dir / name;
+    const std::filesystem::path path = testing::scratch_path(name);
+    std::ofstream(path, std::ios::binary) << contents;
+    return path;
 }
 
 /// Index of the first float whose bits differ, or -1.

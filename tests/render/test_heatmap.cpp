@@ -9,16 +9,12 @@
 
 #include "sim/core/error.hpp"
 #include "sim/render/heatmap.hpp"
+#include "tests/scratch.hpp"
 
 using namespace tpsim;
+using tpsim::testing::scratch_path;
 
 namespace {
-
-std::filesystem::path scratch(const std::string& name) {
-    const auto dir = std::filesystem::temp_directory_path() / "tpsim-test-heatmap";
-    std::filesystem::create_directories(dir);
-    return dir / name;
-}
 
 struct Pixels {
     int width = 0, height = 0, channels = 0;
@@ -65,9 +61,9 @@ TEST_CASE("heat map: the EXR holds each pixel's metric exactly", "[heatmap]") {
     constexpr uint32_t w = 37, h = 23;
     SECTION("fewer items than pixels: the rest are 0") {
         const timing::WorkItemCosts costs = pattern(w * h - 10);
-        const auto files = render::write_heatmap(scratch("few.png"), costs, w, h,
+        const auto files = render::write_heatmap(scratch_path("few.png"), costs, w, h,
                                                  render::HeatMetric::Instructions);
-        CHECK(files.exr == scratch("few.exr"));
+        CHECK(files.exr == scratch_path("few.exr"));
         const Pixels exr = read(files.exr);
         REQUIRE(exr.width == int(w));
         REQUIRE(exr.height == int(h));
@@ -80,7 +76,7 @@ TEST_CASE("heat map: the EXR holds each pixel's metric exactly", "[heatmap]") {
     SECTION("more items than pixels: the extra ones are ignored") {
         const timing::WorkItemCosts costs = pattern(w * h + 50);
         for (const auto metric : {render::HeatMetric::Cycles, render::HeatMetric::DramBytes}) {
-            const auto files = render::write_heatmap(scratch("many.png"), costs, w, h, metric);
+            const auto files = render::write_heatmap(scratch_path("many.png"), costs, w, h, metric);
             const Pixels exr = read(files.exr);
             for (uint32_t i : {0u, 5u, 100u, w * h - 1}) {
                 const auto& item = costs.items[i];
@@ -99,7 +95,7 @@ TEST_CASE("heat map: the PNG maps the values to inferno with a legend below", "[
     for (uint32_t i = 0; i < w * h; ++i)
         costs.items.push_back({uint64_t(10 + (i % w) * 10), 0, 0});  // 10 .. 1000 left to right
     const auto files =
-        render::write_heatmap(scratch("ramp.png"), costs, w, h, render::HeatMetric::Cycles);
+        render::write_heatmap(scratch_path("ramp.png"), costs, w, h, render::HeatMetric::Cycles);
     CHECK(files.legend_problem.empty());  // fonts-dejavu-core is installed by scripts/setup
     const Pixels png = read(files.png);
     REQUIRE(png.channels == 3);
@@ -135,9 +131,9 @@ TEST_CASE("heat map: the PNG maps the values to inferno with a legend below", "[
     // Numbers too wide to share a row with the label push it onto a row of its own.
     for (timing::WorkItemCounters& item : costs.items)
         item.cycles *= 1'000'000'000;
-    const Pixels wide = read(
-        render::write_heatmap(scratch("ramp_wide.png"), costs, w, h, render::HeatMetric::Cycles)
-            .png);
+    const Pixels wide = read(render::write_heatmap(scratch_path("ramp_wide.png"), costs, w, h,
+                                                   render::HeatMetric::Cycles)
+                                 .png);
     CHECK(wide.width == png.width);
     CHECK(wide.height > png.height);
 }
@@ -147,9 +143,9 @@ TEST_CASE("heat map: the log scale spreads heavy-tailed costs", "[heatmap]") {
     timing::WorkItemCosts costs;
     for (uint32_t i = 0; i < w * h; ++i)  // 100 everywhere, one pixel per row 100x that
         costs.items.push_back({i % w == 99 ? 10'000u : 100u + i % w, 0, 0});
-    const auto linear =
-        render::write_heatmap(scratch("tail_linear.png"), costs, w, h, render::HeatMetric::Cycles);
-    const auto log = render::write_heatmap(scratch("tail_log.png"), costs, w, h,
+    const auto linear = render::write_heatmap(scratch_path("tail_linear.png"), costs, w, h,
+                                              render::HeatMetric::Cycles);
+    const auto log = render::write_heatmap(scratch_path("tail_log.png"), costs, w, h,
                                            render::HeatMetric::Cycles, render::HeatScale::Log);
     const Pixels a = read(linear.png), b = read(log.png);
     const auto pixel = [](const Pixels& png, int x) {
@@ -172,10 +168,10 @@ TEST_CASE("heat map: the same costs give the same bytes", "[heatmap]") {
         std::ifstream in(path, std::ios::binary);
         return std::vector<char>(std::istreambuf_iterator<char>(in), {});
     };
-    render::write_heatmap(scratch("a.png"), costs, 64, 64, render::HeatMetric::Cycles);
-    render::write_heatmap(scratch("b.png"), costs, 64, 64, render::HeatMetric::Cycles);
-    CHECK(read_bytes(scratch("a.png")) == read_bytes(scratch("b.png")));
-    CHECK(read_bytes(scratch("a.exr")) == read_bytes(scratch("b.exr")));
+    render::write_heatmap(scratch_path("a.png"), costs, 64, 64, render::HeatMetric::Cycles);
+    render::write_heatmap(scratch_path("b.png"), costs, 64, 64, render::HeatMetric::Cycles);
+    CHECK(read_bytes(scratch_path("a.png")) == read_bytes(scratch_path("b.png")));
+    CHECK(read_bytes(scratch_path("a.exr")) == read_bytes(scratch_path("b.exr")));
 }
 
 TEST_CASE("heat map: inferno rises in lightness from black to yellow", "[heatmap]") {
@@ -208,14 +204,14 @@ TEST_CASE("heat map: a bad metric or path is a clear error", "[heatmap]") {
 
     const timing::WorkItemCosts costs = pattern(16);
     CHECK_THROWS_WITH(
-        render::write_heatmap(scratch("heat.jpg"), costs, 4, 4, render::HeatMetric::Cycles),
+        render::write_heatmap(scratch_path("heat.jpg"), costs, 4, 4, render::HeatMetric::Cycles),
         Catch::Contains("heat.jpg") && Catch::Contains(".png"));
     CHECK_THROWS_WITH(render::write_heatmap("/nonexistent/tpsim/heat.png", costs, 4, 4,
                                             render::HeatMetric::Cycles),
                       Catch::Contains("directory '/nonexistent/tpsim' does not exist"));
     CHECK_THROWS_AS(render::check_heatmap_path("heat.exr"), Error);
-    CHECK_NOTHROW(render::check_heatmap_path(scratch("HEAT.PNG")));
+    CHECK_NOTHROW(render::check_heatmap_path(scratch_path("HEAT.PNG")));
     CHECK_THROWS_WITH(
-        render::write_heatmap(scratch("empty.png"), costs, 0, 4, render::HeatMetric::Cycles),
+        render::write_heatmap(scratch_path("empty.png"), costs, 0, 4, render::HeatMetric::Cycles),
         Catch::Contains("no pixels"));
 }

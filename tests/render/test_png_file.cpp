@@ -5,7 +5,6 @@
 #include <fstream>
 #include <iterator>
 #include <numeric>
-#include <unistd.h>
 
 #include <fmt/format.h>
 
@@ -15,17 +14,12 @@
 #include "sim/render/image_file.hpp"
 #include "sim/render/png_file.hpp"
 #include "sim/render/srgb.hpp"
+#include "tests/scratch.hpp"
 
 using namespace tpsim::render;
+using tpsim::testing::scratch_path;
 
 namespace {
-
-std::filesystem::path scratch(const std::string& name) {
-    const auto dir =
-        std::filesystem::temp_directory_path() / ("tpsim-test-png-" + std::to_string(getpid()));
-    std::filesystem::create_directories(dir);
-    return dir / name;
-}
 
 /// Bytes that differ from pixel to pixel and channel to channel.
 std::vector<uint8_t> pattern(const ImageLayout& layout) {
@@ -54,7 +48,7 @@ TEST_CASE("png: every channel count (grey to RGBA) reads back exactly through Op
         CAPTURE(channels);
         const ImageLayout layout{5, 3, channels, PixelType::UInt8, {}, {}};
         const std::vector<uint8_t> pixels = pattern(layout);
-        const auto path = scratch(fmt::format("c{}.png", channels));
+        const auto path = scratch_path(fmt::format("c{}.png", channels));
         std::string error;
         REQUIRE(write_png(path, layout, pixels, error));
         // As stored: OpenImageIO would otherwise multiply the colours by the alpha.
@@ -80,8 +74,8 @@ TEST_CASE("png: the same pixels give the same bytes in memory and in a file") {
     REQUIRE(!once.empty());
     CHECK(once.compare(1, 3, "PNG") == 0);
     CHECK(encode_png(layout, pixels, error) == once);
-    REQUIRE(write_png(scratch("same.png"), layout, pixels, error));
-    CHECK(file_bytes(scratch("same.png")) == once);
+    REQUIRE(write_png(scratch_path("same.png"), layout, pixels, error));
+    CHECK(file_bytes(scratch_path("same.png")) == once);
 }
 
 TEST_CASE("png: a layout PNG cannot hold and a path that cannot be written give reasons") {
@@ -102,7 +96,7 @@ TEST_CASE("png: a layout PNG cannot hold and a path that cannot be written give 
 TEST_CASE("png: a render's PNG is checked and written without loading the image module") {
     CHECK(is_png("frame.PNG"));
     CHECK_FALSE(is_png("frame.exr"));
-    const auto path = scratch("render.png");
+    const auto path = scratch_path("render.png");
     check_image_path(path);
     std::vector<float> rgb(4 * 2 * 3);
     std::iota(rgb.begin(), rgb.end(), 0.f);
@@ -123,7 +117,7 @@ TEST_CASE("png: a plain PNG reads back as stored without loading the image modul
         CAPTURE(channels);
         const ImageLayout layout{7, 2, channels, PixelType::UInt8, {}, {}};
         const std::vector<uint8_t> pixels = pattern(layout);
-        const auto path = scratch(fmt::format("plain{}.png", channels));
+        const auto path = scratch_path(fmt::format("plain{}.png", channels));
         std::string error;
         REQUIRE(write_png(path, layout, pixels, error));
         Image bytes, floats;
@@ -145,17 +139,17 @@ TEST_CASE("png: what libpng would convert is read by the image module, values as
     // and a PNG written by OpenImageIO (gAMA, cHRM and sRGB chunks: still read by libpng) whose
     // values must equal the module's.
     const ImageLayout rgba{3, 3, 4, PixelType::UInt8, {}, {}};
-    const auto rgba_path = scratch("rgba.png");
+    const auto rgba_path = scratch_path("rgba.png");
     std::string error;
     REQUIRE(write_png(rgba_path, rgba, pattern(rgba), error));
     Image image;
     CHECK_FALSE(read_plain_png(rgba_path, PixelType::UInt8, image));
     CHECK(image.layout.width == 0);  // untouched
-    CHECK_FALSE(read_plain_png(scratch("missing.png"), PixelType::UInt8, image));
+    CHECK_FALSE(read_plain_png(scratch_path("missing.png"), PixelType::UInt8, image));
 
     const ImageLayout rgb{4, 4, 3, PixelType::UInt8, {}, {}};
     const std::vector<uint8_t> pixels = pattern(rgb);
-    const auto oiio_path = scratch("oiio.png");
+    const auto oiio_path = scratch_path("oiio.png");
     auto out = OIIO::ImageOutput::create(oiio_path.string());
     REQUIRE(out);
     OIIO::ImageSpec spec(4, 4, 3, OIIO::TypeDesc::UINT8);

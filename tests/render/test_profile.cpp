@@ -13,8 +13,10 @@
 
 #include "sim/core/error.hpp"
 #include "sim/render/profile.hpp"
+#include "tests/scratch.hpp"
 
 using namespace tpsim;
+using tpsim::testing::scratch_path;
 
 namespace {
 
@@ -70,12 +72,6 @@ template <typename Entries> render::ProfileCosts sum(const Entries& entries) {
     for (const auto& e : entries)
         total += e.costs;
     return total;
-}
-
-std::filesystem::path scratch(const std::string& name) {
-    const auto dir = std::filesystem::temp_directory_path() / "tpsim-test-profile";
-    std::filesystem::create_directories(dir);
-    return dir / name;
 }
 
 std::string read_text(const std::filesystem::path& path) {
@@ -299,7 +295,7 @@ TEST_CASE("profile: short function names drop return types, parameters and names
 
 TEST_CASE("profile: the annotated listing shows lines with their shares", "[profile]") {
     const render::Profile p = render::profile_of(synthetic_profile(tracer()), tracer());
-    const auto path = scratch("tracer.annotate.txt");
+    const auto path = scratch_path("tracer.annotate.txt");
     render::write_annotated_listing(path, p, "tracer.elf");
     const std::string listing = read_text(path);
 
@@ -347,7 +343,7 @@ TEST_CASE("profile: a missing source file is a note in the listing", "[profile]"
     gone.costs.executions = gone.costs.cycles = 10;
     p.lines.push_back(gone);
     p.total = gone.costs;
-    const auto path = scratch("gone.annotate.txt");
+    const auto path = scratch_path("gone.annotate.txt");
     REQUIRE_NOTHROW(render::write_annotated_listing(path, p, "k.elf"));
     const std::string listing = read_text(path);
     CHECK(listing.find("source not found: cannot read /nonexistent/tpsim/gone.hpp") !=

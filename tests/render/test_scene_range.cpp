@@ -10,22 +10,16 @@
 
 #include <catch2/catch.hpp>
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include "sim/image/memory_image.hpp"
 #include "sim/render/render.hpp"
 #include "sim/scene/procedural.hpp"
+#include "tests/scratch.hpp"
 
 using namespace tpsim;
+using tpsim::testing::scratch_path;
 
 namespace {
-
-std::filesystem::path scratch(const std::string& name) {
-    const auto dir =
-        std::filesystem::temp_directory_path() / ("tpsim_scene_range_" + std::to_string(getpid()));
-    std::filesystem::create_directories(dir);
-    return dir / name;
-}
 
 void write(const std::filesystem::path& path, const std::string& text) {
     std::ofstream(path, std::ios::binary) << text;
@@ -33,7 +27,7 @@ void write(const std::filesystem::path& path, const std::string& text) {
 
 /// A sphere resting on a floor quad: curved silhouettes, a shadow on the floor, about 2 units.
 std::filesystem::path sphere_on_floor() {
-    const auto path = scratch("sphere_on_floor.obj");
+    const auto path = scratch_path("sphere_on_floor.obj");
     std::vector<scene::Triangle> triangles;
     generate_sphere({{0.f, 0.f, 0.f}, 1.f, 24, 12}, 0, triangles);
     std::string obj = "v -3 -1 -3\nv 3 -1 -3\nv 3 -1 3\nv -3 -1 3\nf 1 2 3 4\n";
@@ -116,13 +110,13 @@ TEST_CASE("scene range: every decade of mesh scale in [1e-30, 1e30] renders like
           "[render][scale]") {
     const auto mesh = sphere_on_floor();
     for (const bool auto_framed : {false, true}) {
-        const auto reference_path = scratch("scale_ref.toml");
+        const auto reference_path = scratch_path("scale_ref.toml");
         write(reference_path, scaled_scene(mesh, 0, auto_framed));
         const render::RenderResult reference = render_scene(reference_path);
         check_not_blank(reference.rgb);
         for (int decade = -30; decade <= 30; ++decade) {
             if (decade == 0) continue;
-            const auto path = scratch(fmt::format("scale_{}.toml", decade));
+            const auto path = scratch_path(fmt::format("scale_{}.toml", decade));
             write(path, scaled_scene(mesh, decade, auto_framed));
             const render::RenderResult scaled = render_scene(path);
             INFO("scale 1e" << decade << (auto_framed ? ", framed automatically" : ""));
@@ -161,12 +155,12 @@ TEST_CASE("scene range: moving the scene and camera far from the origin changes 
           "[render][translate]") {
     const auto mesh = sphere_on_floor();
     for (const bool auto_framed : {false, true}) {
-        const auto reference_path = scratch("moved_ref.toml");
+        const auto reference_path = scratch_path("moved_ref.toml");
         write(reference_path, moved_scene(mesh, 0, auto_framed));
         const render::RenderResult reference = render_scene(reference_path);
         check_not_blank(reference.rgb);
         for (const double offset : {1e4, 1e6, 1e7}) {
-            const auto path = scratch("moved.toml");
+            const auto path = scratch_path("moved.toml");
             write(path, moved_scene(mesh, offset, auto_framed));
             const render::RenderResult moved = render_scene(path);
             INFO("offset " << offset << (auto_framed ? ", framed automatically" : ""));
@@ -182,7 +176,7 @@ TEST_CASE("scene range: moving the scene and camera far from the origin changes 
     }
     // Where double rounding of the world coordinates is coarser than float resolves the scene,
     // tpsim says so, once, with the fix.
-    const auto far_path = scratch("far.toml");
+    const auto far_path = scratch_path("far.toml");
     write(far_path, moved_scene(mesh, 1e12, false));
     const render::RenderResult far = render_scene(far_path);
     REQUIRE(far.scene.warnings.size() == 1);
@@ -194,7 +188,7 @@ TEST_CASE("scene range: moving the scene and camera far from the origin changes 
 TEST_CASE("scene range: a field of view just below 180 degrees compiles to a finite camera",
           "[render][camera]") {
     // A camera inside a sphere sees it in every direction: nothing may come out NaN or black.
-    const auto path = scratch("wide.toml");
+    const auto path = scratch_path("wide.toml");
     write(path, "[image]\nwidth = 32\nheight = 24\n[camera]\neye = [0.3, 0.2, 0]\n"
                 "look_at = [1, 0.2, 0]\nfov = 179.9999999999\n[[lights]]\n"
                 "position = [0, 0, 0]\nintensity = 1\n[[generators]]\ntype = \"sphere\"\n"

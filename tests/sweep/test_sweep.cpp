@@ -9,22 +9,15 @@
 
 #include "sim/core/error.hpp"
 #include "sim/sweep/sweep.hpp"
+#include "tests/scratch.hpp"
 
 using namespace tpsim::sweep;
+using tpsim::testing::fresh_scratch_dir;
 
 namespace {
 
 const std::filesystem::path kSource = TPSIM_SOURCE_DIR;
 const std::filesystem::path kFixtures = kSource / "tests" / "analysis";
-
-/// A scratch directory of the test's own, emptied first.
-std::filesystem::path scratch(const std::string& name) {
-    const std::filesystem::path dir = std::filesystem::temp_directory_path() /
-                                      ("tpsim_test_sweep_" + std::to_string(getpid())) / name;
-    std::filesystem::remove_all(dir);
-    std::filesystem::create_directories(dir);
-    return dir;
-}
 
 /// Kernels by name resolve to a fake path: expansion does not need them built.
 std::filesystem::path fake_kernel(const std::string& name) {
@@ -60,7 +53,7 @@ std::map<std::string, std::string> ids_by_description(const Sweep& sweep) {
 }  // namespace
 
 TEST_CASE("sweep: axes are crossed in the file's order, the first varying slowest", "[sweep]") {
-    const auto dir = scratch("cross");
+    const auto dir = fresh_scratch_dir("cross");
     const Sweep sweep = load_text(dir, R"(scene = ["scenes/a.toml", "scenes/b.toml"]
 width = 16
 bvh = ["sweep", "binned", "median"]
@@ -95,7 +88,7 @@ size_bytes = [8192, 16384]
 }
 
 TEST_CASE("sweep: zipped axes advance together and are crossed with the rest", "[sweep]") {
-    const auto dir = scratch("zip");
+    const auto dir = fresh_scratch_dir("zip");
     const Sweep sweep = load_text(dir, R"(scene = ["scenes/a.toml", "scenes/b.toml"]
 l1.size_bytes = [8192, 16384, 32768]
 l2.size_bytes = [131072, 262144, 524288]
@@ -120,7 +113,7 @@ zip = [["l1.size_bytes", "l1.ways"], ["l2.size_bytes", "l2.ways"]]
 }
 
 TEST_CASE("sweep: a job's id depends only on its own settings", "[sweep]") {
-    const auto dir = scratch("ids");
+    const auto dir = fresh_scratch_dir("ids");
     const auto small = ids_by_description(load_text(dir, R"(scene = "scenes/a.toml"
 bvh = ["sweep", "binned"]
 l1.size_bytes = [8192, 16384]
@@ -156,7 +149,7 @@ l1.size_bytes = [8192, 16384]
 }
 
 TEST_CASE("sweep: bad sweep files are one line naming file:line", "[sweep]") {
-    const auto dir = scratch("errors");
+    const auto dir = fresh_scratch_dir("errors");
     const std::string file = (dir / "sweep.toml").string();
     CHECK(error_of(dir, "scene = [\"scenes/a.toml\"\n").starts_with(file + ":"));
     CHECK(error_of(dir, "scene = \"scenes/a.toml\"\nl1.size_bites = [1024]\n") ==
@@ -210,7 +203,7 @@ TEST_CASE("sweep: bad sweep files are one line naming file:line", "[sweep]") {
 }
 
 TEST_CASE("sweep: the plan file holds every job's resolved run", "[sweep]") {
-    const auto dir = scratch("plan");
+    const auto dir = fresh_scratch_dir("plan");
     const Sweep sweep = load_text(dir, R"(scene = ["scenes/a.toml", "scenes/b.toml"]
 config = ")" + (kSource / "configs" / "tiny.toml").string() +
                                            R"("
@@ -239,7 +232,7 @@ l2.size_bytes = [4096, 8192]
 
 TEST_CASE("sweep: finished, pending and failed jobs; collect reads the statistics files",
           "[sweep]") {
-    const auto dir = scratch("collect");
+    const auto dir = fresh_scratch_dir("collect");
     const Sweep sweep = load_text(dir, R"(scene = "scenes/a.toml"
 bvh = ["sweep", "binned"]
 l1.size_bytes = [4096, 8192]
@@ -301,7 +294,7 @@ l1.size_bytes = [4096, 8192]
 }
 
 TEST_CASE("sweep: the Slurm script runs each pending job as one array task", "[sweep]") {
-    const auto dir = scratch("slurm");
+    const auto dir = fresh_scratch_dir("slurm");
     const Sweep sweep = load_text(dir, R"(scene = "scenes/a.toml"
 l1.size_bytes = [4096, 8192, 16384]
 )");

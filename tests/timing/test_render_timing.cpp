@@ -12,9 +12,8 @@
 
 #include <catch2/catch.hpp>
 
+#include "tests/scratch.hpp"
 #include "tests/timing/documented_stats.hpp"
-
-#include <unistd.h>
 
 #include <algorithm>
 #include <cstring>
@@ -34,7 +33,7 @@ std::string replaced(std::string text, const std::string& from, const std::strin
     return text.replace(at, from.size(), to);
 }
 
-/// scenes/cornell.toml at 32x32 pixels, written to a temporary file.
+/// scenes/cornell.toml at 32x32 pixels, written to a scratch file.
 std::filesystem::path small_cornell() {
     std::ifstream in(TPSIM_SCENE_DIR "/cornell.toml");
     std::stringstream text;
@@ -42,8 +41,7 @@ std::filesystem::path small_cornell() {
     std::string scene = replaced(text.str(), "width = 256", "width = 32");
     scene = replaced(scene, "height = 256", "height = 32");
     scene = replaced(scene, "path = \"cornell.obj\"", "path = \"" TPSIM_SCENE_DIR "/cornell.obj\"");
-    const auto path = std::filesystem::temp_directory_path() /
-                      ("tpsim_timing_cornell32_" + std::to_string(getpid()) + ".toml");
+    const auto path = tpsim::testing::scratch_path("cornell32.toml");
     std::ofstream(path) << scene;
     return path;
 }
