@@ -11,8 +11,10 @@
 
 #include "sim/cli/commands.hpp"
 #include "sim/core/fault.hpp"
+#include "sim/core/huge_pages.hpp"
 
 int main(int argc, char** argv) {
+    tpsim::core::run_with_huge_page_malloc(argv);
     CLI::App app{"tpsim: a cycle-counting simulator of TRaX ray-tracing hardware"};
     // At most one; none is reported below, so that a misspelt subcommand is named as such
     // instead of "A subcommand is required".

@@ -2,7 +2,11 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <string>
+#include <string_view>
+
 #include <sys/mman.h>
+#include <unistd.h>
 
 namespace tpsim::core {
 
@@ -22,6 +26,20 @@ void* allocate_huge(std::size_t bytes, std::size_t alignment) {
 
 void free_huge(void* block) noexcept {
     std::free(block);
+}
+
+void run_with_huge_page_malloc(char** argv) {
+#ifdef __GLIBC__
+    constexpr std::string_view kTunable = "glibc.malloc.hugetlb";
+    const char* set = std::getenv("GLIBC_TUNABLES");
+    if (set && std::string_view(set).find(kTunable) != std::string_view::npos) return;
+    const std::string tunables =
+        (set && *set ? std::string(set) + ":" : std::string()) + std::string(kTunable) + "=1";
+    if (setenv("GLIBC_TUNABLES", tunables.c_str(), 1) != 0) return;
+    execv("/proc/self/exe", argv);  // returns only if it failed: run without
+#else
+    (void)argv;
+#endif
 }
 
 }  // namespace tpsim::core

@@ -18,6 +18,14 @@ namespace tpsim::core {
 /// The huge-page size asked for (x86-64 and most AArch64 kernels).
 inline constexpr std::size_t kHugePageBytes = std::size_t{2} << 20;
 
+/// Every heap block on huge pages too: glibc's malloc asks for them only when its
+/// glibc.malloc.hugetlb tunable says so at the process's start. Loading a scene faults once per
+/// 4 KiB otherwise (the mesh importer zeroes two 16 MiB buffers for an OBJ file), a third of a
+/// render's fixed cost on a virtual machine (docs/performance.md, "Start-up page faults"). If the
+/// environment does not set the tunable, this adds it and executes the program again with the
+/// same arguments (`argv`); where that cannot be done it returns, and the program runs as it is.
+void run_with_huge_page_malloc(char** argv);
+
 /// Allocates `bytes` aligned to `alignment` (a power of two). A block of at least one huge
 /// page is aligned to a huge page, in whole huge pages, and the kernel is asked to back it with
 /// huge pages (a request: without them it is ordinary memory); a smaller one is an ordinary heap
