@@ -24,6 +24,8 @@ inline constexpr std::size_t kHugePageBytes = std::size_t{2} << 20;
 /// render's fixed cost on a virtual machine (docs/performance.md, "Start-up page faults"). If the
 /// environment does not set the tunable, this adds it and executes the program again with the
 /// same arguments (`argv`); where that cannot be done it returns, and the program runs as it is.
+/// (Under a tool that does not follow exec, valgrind without --trace-children=yes say, set the
+/// tunable: GLIBC_TUNABLES=glibc.malloc.hugetlb=0.)
 void run_with_huge_page_malloc(char** argv);
 
 /// Allocates `bytes` aligned to `alignment` (a power of two). A block of at least one huge
