@@ -484,6 +484,12 @@ struct Chip::HostThreads {
         done.arrive_and_wait();
     }
     uint32_t lanes() const { return turns.lanes(); }
+    /// Whether every lane has ticked its TMs through the stretches before `stretch`.
+    bool ticked_before(uint64_t stretch) const {
+        for (uint32_t l = 0; l < lanes(); ++l)
+            if (lane[l].ticked.value.load(std::memory_order_acquire) < stretch) return false;
+        return true;
+    }
 
     core::OrderedTurns turns;
     // A lane that failed: where in the order, and what (the earliest is rethrown).
@@ -588,9 +594,7 @@ void Chip::resize_blocks(uint64_t stretch) {
     // The last change must have reached every lane.
     if (host.pending) return;
     const uint64_t switched = host.switch_at.value.load(std::memory_order_relaxed);
-    if (switched != kNever)
-        for (uint32_t lane = 0; lane < lanes; ++lane)
-            if (host.lane[lane].ticked.value.load(std::memory_order_acquire) <= switched) return;
+    if (switched != kNever && !host.ticked_before(switched + 1)) return;
     std::vector<core::LaneLoad> loads(lanes);
     std::vector<bool> running(tms_.size());
     for (uint32_t t = 0; t < tms_.size(); ++t)
@@ -914,8 +918,7 @@ template <class Source> void Chip::run_pipelined(uint64_t end, Source& source) {
     const auto run_shared = [&](uint32_t lane) {
         const uint64_t s = load(host.shared);
         if (begin(s) >= end || s >= load(host.shared_limit)) return false;
-        for (uint32_t l = 0; l < lanes; ++l)
-            if (load(host.lane[l].ticked) <= s) return false;
+        if (!host.ticked_before(s + 1)) return false;
         uint64_t untaken = s;  // no lane has taken stretch s on (nor is running an earlier one)
         if (!host.shared_taken.value.compare_exchange_strong(untaken, s + 1)) return false;
         Progress progress;
@@ -950,15 +953,10 @@ template <class Source> void Chip::run_pipelined(uint64_t end, Source& source) {
             // New blocks from this stretch on: each lane's TMs must have left stretch k - 1
             // behind first.
             const bool new_blocks = k == load(host.switch_at);
-            const auto all_ticked = [&] {
-                for (uint32_t l = 0; l < lanes; ++l)
-                    if (load(host.lane[l].ticked) < k) return false;
-                return true;
-            };
             if (new_blocks)
                 core::spin_until(
                     [&] {
-                        if (all_ticked() || k >= load(host.lane_limit)) return true;
+                        if (host.ticked_before(k) || k >= load(host.lane_limit)) return true;
                         run_shared(lane);
                         return false;
                     },
