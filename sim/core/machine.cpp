@@ -212,6 +212,33 @@ void Machine::run_quantum(uint32_t id, uint64_t budget, Counters& counters, Turn
     counters.instructions += done;
 }
 
+void Machine::clock_by(const uint64_t* cycles, uint32_t stride) {
+    if (held_) held_->write_through(UINT64_MAX, memory_);
+    cycle_counters_ = cycles;
+    cycle_stride_ = stride;
+    held_ = cycles ? std::make_unique<HeldStores>(uint32_t(counter_lanes_.size())) : nullptr;
+}
+
+void Machine::hold_store(uint32_t id, const StepRecord& store) {
+    held_->hold(id / config_.threads_per_tm,
+                {position_of(id), store.mem_address, store.value, store.mem_bytes});
+}
+
+void Machine::write_held_before_step(uint32_t id) {
+    const isa::Hart& h = threads_[id].hart;
+    const CodeRange* range = h.pc % 4 == 0 ? code_range_at(h.pc) : nullptr;
+    if (!range) return;  // a fetch fault reads nothing
+    const uint32_t index = (h.pc - range->base) / 4;
+    const isa::FuClass fu = decoded_[range->first + index].fu;
+    if (fu == isa::FuClass::Print ||
+        (fu == isa::FuClass::Load && !is_private(h, index, range->words, range->first)))
+        held_->write_through(position_of(id), memory_);
+}
+
+void Machine::write_held_before(uint64_t cycle) {
+    if (held_ && cycle != 0) held_->write_through(cycle * counter_lanes_.size() - 1, memory_);
+}
+
 Counters Machine::counters() const {
     Counters sum;
     for (const CounterLane& lane : counter_lanes_) {
@@ -334,7 +361,7 @@ bool Machine::read_csr(uint32_t id, uint32_t csr, uint32_t& value) const {
     namespace c = isa::csr;
     const uint32_t per_tm = config_.threads_per_tm;
     // Functionally every instruction takes one cycle, so cycle = instret; the timing model
-    // supplies real cycles (set_cycle_counters). (instret itself is the hart's.)
+    // supplies real cycles (clock_by). (instret itself is the hart's.)
     const uint64_t cycles =
         cycle_counters_ ? cycle_counters_[id / per_tm * cycle_stride_] : threads_[id].hart.instret;
     switch (csr) {
@@ -575,8 +602,8 @@ void Machine::refuse_step(uint32_t id) {
 
 StepRecord Machine::step(uint32_t id) {
     StepRecord record;
-    uint32_t done = 0;
-    run_ahead(id, &record, 1, done);
+    uint32_t done = 0, first_held = 0;
+    run_ahead(id, &record, 1, done, first_held);
     return record;
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -11,6 +12,7 @@
 #include "kernel/memory_map.hpp"
 #include "sim/core/elf_loader.hpp"
 #include "sim/core/fault.hpp"
+#include "sim/core/held_stores.hpp"
 #include "sim/core/host_spacing.hpp"
 #include "sim/core/memory.hpp"
 
@@ -75,8 +77,9 @@ constexpr bool in_local_store(uint32_t addr) {
 struct StepRecord {
     uint32_t pc = 0;  ///< address of the instruction
     /// The value an atomic increment returned; for the synchronisation instructions what the
-    /// chip needs to time them (see Machine::barrier and the semaphore functions).
-    uint32_t atomic_result = 0;
+    /// chip needs to time them (see Machine::barrier and the semaphore functions); for a
+    /// store the machine holds (Machine::clock_by), the bytes it stores.
+    uint32_t value = 0;
     const isa::Decoded* insn = nullptr;  ///< its pre-decoded form (registers, FU class)
     /// Effective address when mem_bytes != 0 (in the thread's own local store when
     /// in_local_store(mem_address): no cache, no traffic).
@@ -114,10 +117,13 @@ public:
     StepRecord step(uint32_t thread);
     /// The timing model's batched step(): executes thread `id`'s next instruction, then the
     /// following ones while they are private (is_private), at most `capacity` in all (and
-    /// never past the instruction limit), writing their records to out[0..done). If an
-    /// instruction faults, the Fault is thrown with `done` counting the records written before
-    /// it. Defined in thread_env.hpp so the cycle loop can inline it.
-    inline void run_ahead(uint32_t id, StepRecord* out, uint32_t capacity, uint32_t& done);
+    /// never past the instruction limit), writing their records to out[0..done);
+    /// `first_held` is the index of the first store held back (timing mode, clock_by), or
+    /// UINT32_MAX. If an instruction faults, the Fault is thrown with `done` and `first_held`
+    /// counting the records written before it. Defined in thread_env.hpp so the cycle loop
+    /// can inline it.
+    inline void run_ahead(uint32_t id, StepRecord* out, uint32_t capacity, uint32_t& done,
+                          uint32_t& first_held);
     /// Functional warming's step (timing::Chip::warm): executes up to `budget` instructions of
     /// thread `id` (never past the instruction limits) without records; `observer` hears of
     /// every load, store and atomic increment as ThreadEnv describes. Stops after an exit or
@@ -128,14 +134,21 @@ public:
     inline bool run_observed(uint32_t id, uint64_t budget, uint64_t& executed, StepRecord& last,
                              Observer& observer);
 
-    /// Timing mode: the cycle/time CSRs of a thread in TM t read `cycles[t * stride]` (the
-    /// cycle that TM is simulating: TMs may be simulated on different host threads, each at
-    /// its own cycle) instead of instret; nullptr (the default) = functional mode, where
-    /// cycle = instret. The counters must outlive the instructions that read them.
-    void set_cycle_counters(const uint64_t* cycles, uint32_t stride) {
-        cycle_counters_ = cycles;
-        cycle_stride_ = stride;
-    }
+    /// Timing mode, for the timing model's MachineSource: the cycle/time CSRs of a thread in
+    /// TM t read `cycles[t * stride]` (the cycle that TM is simulating: TMs may be simulated
+    /// on different host threads, each at its own cycle) instead of instret; and a store to
+    /// shared memory (outside the thread's local store) is private: run_ahead checks it but
+    /// holds it back, its bytes in its record, for hold_store() when the chip fetches it.
+    /// nullptr (the default) = functional mode, where cycle = instret and stores write at
+    /// once; leaving timing mode writes what is still held. The counters must outlive the
+    /// instructions that read them.
+    void clock_by(const uint64_t* cycles, uint32_t stride);
+    /// Timing mode: thread `id`'s store (its record from run_ahead) is fetched; it joins the
+    /// held stores at its TM's position (cycle * TMs + TM) in the order.
+    void hold_store(uint32_t id, const StepRecord& store);
+    /// Timing mode: every step before cycle `cycle` has happened; the stores held from those
+    /// steps are written.
+    void write_held_before(uint64_t cycle);
     /// Whether thread `id`'s next instruction is private (is_private): running it at any
     /// moment, whatever other threads run meanwhile, gives the same result. False for an
     /// instruction that touches shared state, and for a thread that is not running.
@@ -200,9 +213,14 @@ private:
         return left;
     }
     [[noreturn]] void refuse_step(uint32_t id);
+    /// Timing mode, before run_ahead's first step (the chip's fetch, in its turn if the step
+    /// is not private): if the step reads shared memory (a load that is not private, a
+    /// print), every store held before it in the order is written. Cold: run_ahead calls it
+    /// only for a load or print.
+    [[gnu::cold]] void write_held_before_step(uint32_t id);
 
     // The synchronisation instructions and exit (ThreadEnv's hooks). Each returns what the
-    // chip needs to time it (StepRecord::atomic_result): barrier() the number of threads the
+    // chip needs to time it (StepRecord::value): barrier() the number of threads the
     // arrival lets go on (itself included; 0 if it waits), sem_acquire() 1 if it got the
     // semaphore at once (0: it waits until a release hands it over), sem_release() 1 + the
     // thread it hands the semaphore to (0: none waited), exited() the number of threads
@@ -233,11 +251,11 @@ private:
     [[gnu::cold, gnu::noinline]] void illegal(uint32_t id, isa::Hart& h, const isa::Decoded& d);
     /// True if the instruction at word `index` of the code range whose decoded words start at
     /// word `first` (any index: outside the range's `words` is not private), run by hart `h`,
-    /// touches only the thread's own state (registers, pc, local
-    /// store) or reads the read-only scene: executing it earlier or later than other threads'
-    /// instructions cannot change any result. False for shared-memory accesses, atomics and
-    /// CSR/system instructions (whose results may depend on when they run). Defined in
-    /// thread_env.hpp.
+    /// touches only the thread's own state (registers, pc, local store), reads the read-only
+    /// scene or, in timing mode, stores to shared memory (held: clock_by): executing it
+    /// earlier or later than other threads' instructions cannot change any result. False for
+    /// other shared-memory accesses, atomics and CSR/system instructions (whose results may
+    /// depend on when they run). Defined in thread_env.hpp.
     inline bool is_private(const isa::Hart& h, uint32_t index, uint32_t words,
                            uint32_t first) const;
 
@@ -276,6 +294,13 @@ private:
     }
     const uint64_t* cycle_counters_ = nullptr;
     uint32_t cycle_stride_ = 0;
+    /// Timing mode's stores, one producer per TM; none in functional mode.
+    std::unique_ptr<HeldStores> held_;
+    /// Thread `id`'s place in the timing mode's order: its TM's cycle * TMs + its TM.
+    uint64_t position_of(uint32_t id) const {
+        const uint32_t tm = id / config_.threads_per_tm;
+        return cycle_counters_[size_t(tm) * cycle_stride_] * counter_lanes_.size() + tm;
+    }
 };
 
 }  // namespace tpsim::core

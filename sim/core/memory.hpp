@@ -1,5 +1,6 @@
 // Guest memory: the documented address map (docs/memory-map.md) over flat host buffers.
 #pragma once
+#include <bit>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -66,6 +67,16 @@ public:
 
     template <class T> void store(uint32_t addr, T value, uint8_t* local) {
         std::memcpy(locate(addr, sizeof(T), local, /*store=*/true), &value, sizeof(T));
+    }
+    /// Throws the GuestFault a store of `bytes` at `addr` would, without storing.
+    void check_store(uint32_t addr, uint32_t bytes, uint8_t* local) const {
+        locate(addr, bytes, local, /*store=*/true);
+    }
+    /// Stores the low `bytes` bytes of `value` at `addr`, outside every local store (a held
+    /// store, checked when it executed).
+    void write(uint32_t addr, uint32_t bytes, uint32_t value) {
+        static_assert(std::endian::native == std::endian::little, "low bytes first");
+        std::memcpy(locate(addr, bytes, nullptr, /*store=*/true), &value, bytes);
     }
 
     /// Reads an instruction word of the program (for disassembly in messages); 0 if unmapped.

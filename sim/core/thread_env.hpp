@@ -3,6 +3,7 @@
 // instead of calling through machine.cpp for every simulated instruction.
 #pragma once
 #include <bit>
+#include <cstring>
 #include <type_traits>
 
 #include <fmt/format.h>
@@ -46,8 +47,20 @@ public:
     }
 
     template <class T> void store(uint32_t addr, T value) {
-        if constexpr (kRecord) record_access(addr, sizeof(T), true);
         if constexpr (kObserved) observer_->access(addr, sizeof(T), true);
+        if constexpr (kRecord) {
+            record_access(addr, sizeof(T), true);
+            // Timing mode: a store to shared memory is held until the chip fetches it
+            // (Machine::clock_by); a bad address faults now.
+            if (machine_.held_ && !in_local_store(addr)) [[unlikely]] {
+                machine_.memory_.check_store(addr, sizeof(T), local_);
+                uint32_t bytes = 0;
+                std::memcpy(&bytes, &value, sizeof(T));
+                record_->value = bytes;
+                if (!first_held_) first_held_ = record_;
+                return;
+            }
+        }
         machine_.memory_.store<T>(addr, value, local_);
     }
 
@@ -57,7 +70,7 @@ public:
         const uint32_t old = machine_.global_registers_[global_register]++;
         // Register 0 hands out the work items (pixels): a new item starts.
         if (global_register == 0) thread_.item_start = thread_.hart.instret;
-        if constexpr (kRecord) record_->atomic_result = old;
+        if constexpr (kRecord) record_->value = old;
         if constexpr (kObserved) observer_->atomic(global_register, old);
         return old;
     }
@@ -105,6 +118,8 @@ public:
 
     /// Where the next instruction's bookkeeping goes (recording environments only).
     void record_into(StepRecord* record) { record_ = record; }
+    /// The record of the first store held back (timing mode), or nullptr.
+    const StepRecord* first_held() const { return first_held_; }
 
 private:
     [[noreturn, gnu::cold, gnu::noinline]] static void bad_global_register(uint32_t index) {
@@ -122,9 +137,9 @@ private:
                          "mtvec"};
     }
 
-    /// What a synchronisation instruction or exit tells the chip (StepRecord::atomic_result).
+    /// What a synchronisation instruction or exit tells the chip (StepRecord::value).
     void report(uint32_t value) {
-        if constexpr (kRecord) record_->atomic_result = value;
+        if constexpr (kRecord) record_->value = value;
     }
 
     void record_access(uint32_t addr, uint8_t bytes, bool store) {
@@ -139,6 +154,7 @@ private:
     uint8_t* local_;
     [[no_unique_address]] Record record_;
     [[no_unique_address]] ObserverRef observer_;
+    const StepRecord* first_held_ = nullptr;
 };
 
 // The timing model's hot path: the functional core's stretch of one thread (see
@@ -146,8 +162,9 @@ private:
 // GCC would otherwise keep isa::execute out of line (too big for its inliner), which costs a
 // call and keeps the environment and record in memory instead of registers.
 [[gnu::flatten]] inline void Machine::run_ahead(uint32_t id, StepRecord* out, uint32_t capacity,
-                                                uint32_t& done) {
+                                                uint32_t& done, uint32_t& first_held) {
     done = 0;
+    first_held = UINT32_MAX;
     // config_.threads, not threads_.size(): no division by sizeof(Thread).
     if (id >= config_.threads) [[unlikely]]
         refuse_step(id);
@@ -170,10 +187,19 @@ private:
     uint32_t n = 0;  // records written
     const auto count = [&] {
         done = n;
+        if (env.first_held()) first_held = uint32_t(env.first_held() - out);
         t.executed += n;
         counters.instructions += n;
     };
     uint32_t pc = h.pc;
+    // Timing mode: a load or print in its turn reads shared memory after the stores held
+    // before it are written.
+    if (held_) {
+        const uint32_t index = std::rotr(pc - text_base, 2);
+        const isa::FuClass fu = index < text_words ? decoded[index].fu : isa::FuClass::Load;
+        if (fu == isa::FuClass::Load || fu == isa::FuClass::Print) [[unlikely]]
+            write_held_before_step(id);
+    }
     try {
         for (;;) {
             pc = h.pc;
@@ -307,7 +333,9 @@ inline bool Machine::is_private(const isa::Hart& h, uint32_t index, uint32_t wor
     // scene, the kernel's constants) see the same value whenever they run.
     const isa::Decoded& d = decoded_[index];
     const uint32_t addr = h.reg[d.rs1] + uint32_t(d.imm);
-    return in_local_store(addr) || (privacy == Privacy::Load && memory_.in_read_only(addr));
+    // A store the machine holds (timing mode) changes nothing another thread can see yet.
+    return in_local_store(addr) ||
+           (privacy == Privacy::Load ? memory_.in_read_only(addr) : held_ != nullptr);
 }
 
 inline bool Machine::next_is_private(uint32_t id) const {

@@ -35,6 +35,9 @@ constexpr uint64_t kSyncWait = kNever - 1;
 /// reply wakes it (Tm::wake_from_fetches).
 constexpr uint64_t kFetchWait = kNever - 2;
 constexpr uint64_t kDeadlockCycles = 1'000'000;
+/// Cycles between the shared parts' InstructionSource::passed calls (MachineSource: a TM of
+/// 32 TPs holds at most 8,192 stores meanwhile).
+constexpr uint64_t kPassedEvery = 256;
 constexpr size_t kPools = static_cast<size_t>(Pool::Count);
 constexpr size_t kStalls = static_cast<size_t>(Stall::Count);
 
@@ -627,11 +630,11 @@ Chip::Chip(const ChipConfig& config, MachineSource& source, const ChipLayout& la
     // During TM t's tick of cycle `now`, clocks_[t] == now, so an instruction sees the cycle it
     // is fetched (and executed) in.
     clocked_machine_ = &source.machine();
-    clocked_machine_->set_cycle_counters(&clocks_[0].now, sizeof(TmClock) / sizeof(uint64_t));
+    clocked_machine_->clock_by(&clocks_[0].now, sizeof(TmClock) / sizeof(uint64_t));
 }
 
 Chip::~Chip() {
-    if (clocked_machine_) clocked_machine_->set_cycle_counters(nullptr, 0);
+    if (clocked_machine_) clocked_machine_->clock_by(nullptr, 0);
 }
 
 bool Chip::run_until(uint64_t cycle) {
@@ -874,6 +877,7 @@ template <class Source> bool Chip::run_cycles(uint64_t end) {
             shared_stretch(first, stretch_end, progress, source);
         }
     }
+    source.passed(cycles_);  // a paused chip's steps are all visible
     finished_ = finished_ || drained();
     collect();
     return finished_;
@@ -1037,6 +1041,9 @@ void Chip::shared_stretch(uint64_t first, uint64_t end, Progress progress, Sourc
         tick_shared(now);
     }
     cycles_ = now;
+    // Every TM has ticked the stretch: every few hundred cycles, the source makes visible what
+    // it held back of the steps before it (so that it holds little).
+    if (now / kPassedEvery != first / kPassedEvery) source.passed(now);
     for (auto& tm : tms_)
         if (idle_in_stretch(*tm)) progress.add(std::exchange(tm->progress_cycles, {}));
     progress.add(shared_progress_);
@@ -1252,7 +1259,7 @@ void Chip::send_sync(Tm& tm, uint32_t i, const StepInfo& s, uint64_t now) {
     const GlobalRequest kind = op == isa::Op::tp_barrier  ? GlobalRequest::Barrier
                                : op == isa::Op::tp_semacq ? GlobalRequest::SemAcquire
                                                           : GlobalRequest::SemRelease;
-    tm.atomics_out.push_back({now, tm.id, tm.atomic_sequence++, i, 0, kind, s.atomic_result,
+    tm.atomics_out.push_back({now, tm.id, tm.atomic_sequence++, i, 0, kind, s.value,
                               tm.id * config_.chip.tps_per_tm + i});
     // Asleep until the unit's reply (wake_from_sync): the TP fetches nothing meanwhile.
     Tm::Tp& tp = tm.tps[i];
@@ -1439,7 +1446,7 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
             // atomicinc(0) hands out the next work item; it is the first instruction of it.
             if (fu == isa::FuClass::Atomic && d.imm == 0) [[unlikely]] {
                 tm.charges.push_back({tp.item, now - tp.item_since, tp.item_instructions});
-                tp.item = s.atomic_result;
+                tp.item = s.value;
                 tp.item_since = now;
                 tp.item_instructions = 0;
             }
@@ -1474,10 +1481,9 @@ void Chip::tick_tm(Tm& tm, uint64_t now, Source& source) {
                 clear_bit(tm.awake_tps, i);
                 if (--tm.running == 0) tm.idle_from.store(now + 1, std::memory_order_relaxed);
                 tm.charges.push_back({tp.item, now + 1 - tp.item_since, tp.item_instructions});
-                if (s.atomic_result != 0)  // the exit lets threads at the barrier go on
+                if (s.value != 0)  // the exit lets threads at the barrier go on
                     tm.atomics_out.push_back({now, tm.id, tm.atomic_sequence++, i, 0,
-                                              GlobalRequest::Exit, s.atomic_result,
-                                              first_thread + i});
+                                              GlobalRequest::Exit, s.value, first_thread + i});
             } else if (fu == isa::FuClass::Branch) {
                 // The bubble after a branch: no fetch before now + 1 + bubble.
                 const uint32_t bubble =

@@ -58,6 +58,10 @@ public:
     /// The chip is about to tick thread `thread`'s TM for a few cycles: a hint to bring what
     /// its next step reads into the host's caches. The default does nothing.
     virtual void prefetch_next(uint32_t /*thread*/) const {}
+    /// Every step fetched before cycle `cycle` has happened: what the source held back of
+    /// them (MachineSource: stores to shared memory) may be made visible now. The chip says
+    /// so every few hundred cycles and whenever a run pauses. The default does nothing.
+    virtual void passed(uint64_t /*cycle*/) {}
 };
 
 class MachineSource;  // machine_source.hpp

@@ -16,7 +16,7 @@
 namespace tpsim::timing {
 
 /// What a request asks of the unit. The synchronisation requests carry what the functional
-/// core decided when it executed the instruction (core::StepRecord::atomic_result), so that
+/// core decided when it executed the instruction (core::StepRecord::value), so that
 /// the unit replies in timing order with the same outcome: a TP waiting at the barrier or for
 /// a semaphore gets its reply only once every request that lets it go on has been served.
 enum class GlobalRequest : uint8_t {

@@ -81,12 +81,17 @@ public:
         Cursor& c = cursor(thread);
         Records& records = records_[record_slot(thread)];
         if (c.next == c.size) run_ahead(thread, c, records);
+        if (c.next == c.held) [[unlikely]]
+            hold(thread, c, records);
         out = records[c.next++];
         // The chip takes a thread's records one at a time, among those of a thousand other
         // threads on large chips: the buffer's next line is fetched before it is needed.
         __builtin_prefetch(&records[std::min<uint32_t>(c.next + kPrefetchAhead, kAhead - 1)]);
         c.pc = c.next < c.size ? records[c.next].pc : machine_.next_pc(thread);
     }
+
+    /// Writes the stores held from the steps before `cycle` (Machine::write_held_before).
+    void passed(uint64_t cycle) override { machine_.write_held_before(cycle); }
 
     /// Functional warming (Chip::warm): thread `thread` executes up to `budget` instructions,
     /// first those it has run ahead, and `observer` hears of their loads, stores and atomic
@@ -102,8 +107,12 @@ public:
         while (c.next < c.size && executed < budget && !stopped) {
             const StepInfo& s = records[c.next++];
             ++executed;
+            // Warming writes its stores at once, as it executes them (after a drain, nothing
+            // is held): so does a store run ahead.
+            if (held(s)) machine_.memory().write(s.mem_address, s.mem_bytes, s.value);
             stopped = replay(s, last, observer);
         }
+        c.held = next_held(records, c.next, c.size);
         if (executed < budget && !stopped) {
             raise_fault_due(thread);
             uint64_t more = 0;
@@ -124,8 +133,7 @@ public:
             return true;
         }
         if (s.mem_bytes != 0) observer.access(s.mem_address, s.mem_bytes, s.mem_store);
-        if (s.insn->fu == isa::FuClass::Atomic)
-            observer.atomic(uint32_t(s.insn->imm), s.atomic_result);
+        if (s.insn->fu == isa::FuClass::Atomic) observer.atomic(uint32_t(s.insn->imm), s.value);
         return false;
     }
 
@@ -141,13 +149,15 @@ private:
     struct alignas(core::kHostSpacing) AlignedRecords : Records {};
     static constexpr uint32_t kBlockThreads = 32;
     static uint32_t record_slot(uint32_t thread) { return thread + thread / kBlockThreads; }
-    // What the chip reads of a thread at every fetch, dense: the pc it fetches next and its
-    // place in its records (records[next, size) are run ahead, not yet taken).
+    // What the chip reads of a thread at every fetch, dense: the pc it fetches next, its place
+    // in its records (records[next, size) are run ahead, not yet taken) and the next of them
+    // that is a store held back (kNoneHeld: none).
     struct Cursor {
         uint32_t pc = 0;
-        uint16_t next = 0, size = 0;
+        uint8_t next = 0, size = 0, held = kNoneHeld;
     };
-    static_assert(kAhead <= UINT16_MAX);
+    static constexpr uint8_t kNoneHeld = UINT8_MAX;
+    static_assert(kAhead < kNoneHeld);
     // In whole pairs of cache lines (core::kHostSpacing): TMs of a multiple of 16 threads (32
     // by default) never share one. Blocks of 32 threads are core::kTmSpacing apart, as above.
     static constexpr uint32_t kCursorsPerLine = core::kHostSpacing / sizeof(Cursor);
@@ -174,6 +184,23 @@ private:
         return !faults_[thread] && machine_.next_is_private(thread);
     }
 
+    /// Whether a record is a store the machine held back: one to shared memory (timing mode,
+    /// core::Machine::clock_by).
+    static bool held(const StepInfo& s) {
+        return s.mem_store && !core::in_local_store(s.mem_address);
+    }
+    static uint8_t next_held(const Records& records, uint32_t from, uint32_t size) {
+        for (uint32_t k = from; k < size; ++k)
+            if (held(records[k])) return uint8_t(k);
+        return kNoneHeld;
+    }
+    /// The chip fetches a store held back: it happens now (Machine::hold_store). Out of line:
+    /// a few stores per work item go to shared memory.
+    [[gnu::cold, gnu::noinline]] void hold(uint32_t thread, Cursor& c, const Records& records) {
+        machine_.hold_store(thread, records[c.next]);
+        c.held = next_held(records, c.next + 1u, c.size);
+    }
+
     /// A fault of an instruction run ahead is raised when the chip comes to that instruction.
     void raise_fault_due(uint32_t thread) {
         if (faults_[thread]) std::rethrow_exception(std::exchange(faults_[thread], nullptr));
@@ -181,17 +208,19 @@ private:
 
     void run_ahead(uint32_t thread, Cursor& c, Records& records) {
         raise_fault_due(thread);
-        uint32_t size = 0;
+        uint32_t size = 0, first_held = kNoneHeld;
         try {
-            machine_.run_ahead(thread, records.data(), kAhead, size);
+            machine_.run_ahead(thread, records.data(), kAhead, size, first_held);
         } catch (...) {
             c.next = c.size = 0;
+            c.held = kNoneHeld;
             if (size == 0) throw;  // the fetched instruction itself: its fault is due now
             // A later one's: raised when the chip fetches it (its pc stays the thread's pc).
             faults_[thread] = std::current_exception();
         }
         c.next = 0;
-        c.size = uint16_t(size);
+        c.size = uint8_t(size);
+        c.held = first_held < size ? uint8_t(first_held) : kNoneHeld;
     }
 
     core::Machine& machine_;
