@@ -604,6 +604,7 @@ StepRecord Machine::step(uint32_t id) {
     StepRecord record;
     uint32_t done = 0, first_held = 0;
     run_ahead(id, &record, 1, done, first_held);
+    if (first_held == 0) hold_store(id, record);  // timing mode: a store happens at its step
     return record;
 }
 

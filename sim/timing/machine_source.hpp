@@ -50,6 +50,8 @@ inline std::unique_ptr<core::Machine> make_machine(const core::Program& program,
 /// that see shared state still execute in fetch order and cycle, so results are the same as
 /// executing each at its fetch, while the functional core runs a thread's code in stretches,
 /// which the host's branch predictors handle far better than one instruction per thread in turn.
+/// Stores to shared memory run ahead too, held back by the machine (core::Machine::clock_by):
+/// each happens when the chip fetches it.
 class MachineSource final : public InstructionSource {
 public:
     explicit MachineSource(core::Machine& machine)
