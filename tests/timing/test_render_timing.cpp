@@ -204,11 +204,11 @@ TEST_CASE("running threads ahead through private instructions changes nothing th
             timing::apply_override(chip, "icache.threads_per_icache=2");
             timing::apply_override(chip, "chip.num_tms=3");
             INFO(kernel << ' ' << shape);
+            const ChipRun at_fetch = run_chip<StepAtFetch>(chip, 0, {}, kernel);
             for (uint32_t host_threads : {1u, 3u}) {
                 INFO("host threads " << host_threads);
                 const ChipRun ahead =
                     run_chip<timing::MachineSource>(chip, 997, {host_threads}, kernel);
-                const ChipRun at_fetch = run_chip<StepAtFetch>(chip, 0, {}, kernel);
                 CHECK(ahead.stats == at_fetch.stats);
                 CHECK(ahead.global == at_fetch.global);
                 CHECK(ahead.output == at_fetch.output);
