@@ -1,6 +1,6 @@
 // Turns in a fixed order for work spread over host threads (lanes): each lane walks through
 // increasing positions of one global order (e.g. cycle * TMs + TM) and publishes where it is;
-// an action that other lanes can observe (an atomic increment, a global store, a print) waits
+// an action that other lanes can observe (an atomic increment, a shared load, a print) waits
 // until every other lane has moved past its position. Such actions then happen in the order of
 // their positions, whatever the host does, and each sees exactly the effects of the earlier
 // ones (the release/acquire on the positions orders the memory). Lanes never wait in a cycle:
