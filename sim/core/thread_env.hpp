@@ -193,7 +193,8 @@ private:
     };
     uint32_t pc = h.pc;
     // Timing mode: a load or print in its turn reads shared memory after the stores held
-    // before it are written.
+    // before it are written. (A pc outside the entry's code range is left to the out-of-line
+    // check, which finds its range.)
     if (held_) {
         const uint32_t index = std::rotr(pc - text_base, 2);
         const isa::FuClass fu = index < text_words ? decoded[index].fu : isa::FuClass::Load;

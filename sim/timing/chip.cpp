@@ -36,7 +36,8 @@ constexpr uint64_t kSyncWait = kNever - 1;
 constexpr uint64_t kFetchWait = kNever - 2;
 constexpr uint64_t kDeadlockCycles = 1'000'000;
 /// Cycles between the shared parts' InstructionSource::passed calls (MachineSource: a TM of
-/// 32 TPs holds at most 8,192 stores meanwhile).
+/// 32 TPs holds about 8,192 stores meanwhile at most, a few more on several host threads, whose
+/// lanes run up to a lookahead ahead).
 constexpr uint64_t kPassedEvery = 256;
 constexpr size_t kPools = static_cast<size_t>(Pool::Count);
 constexpr size_t kStalls = static_cast<size_t>(Stall::Count);
