@@ -12,6 +12,7 @@
 
 #include "isa/csr.hpp"
 #include "sim/core/error.hpp"
+#include "sim/core/held_stores.hpp"
 #include "sim/core/ordered_turns.hpp"
 #include "sim/core/thread_env.hpp"
 
@@ -79,6 +80,9 @@ Machine::Machine(Program program, const MachineConfig& config)
             trax::map::kLocalTop;  // the runtime may set it again; asm tests need not
     }
 }
+
+Machine::Machine(Machine&&) noexcept = default;
+Machine::~Machine() = default;
 
 void Machine::fault(uint32_t id, uint32_t pc, const GuestFault& what) {
     threads_[id].state = ThreadState::Faulted;

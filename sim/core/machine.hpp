@@ -12,11 +12,12 @@
 #include "kernel/memory_map.hpp"
 #include "sim/core/elf_loader.hpp"
 #include "sim/core/fault.hpp"
-#include "sim/core/held_stores.hpp"
 #include "sim/core/host_spacing.hpp"
 #include "sim/core/memory.hpp"
 
 namespace tpsim::core {
+
+class HeldStores;
 
 struct MachineConfig {
     /// Hardware threads (one per thread processor); each starts at the ELF entry.
@@ -104,6 +105,9 @@ constexpr uint32_t kMaxPrintBytes = 4096;
 class Machine {
 public:
     Machine(Program program, const MachineConfig& config);
+    // Out of line: HeldStores is complete only in machine.cpp.
+    Machine(Machine&&) noexcept;
+    ~Machine();
 
     /// Runs every thread to its exit, round-robin by thread id in fixed quanta (a waiting thread
     /// is passed over until it may go on), so results never depend on anything but the program
