@@ -229,18 +229,11 @@ void Machine::hold_store(uint32_t id, const StepRecord& store) {
 }
 
 void Machine::write_held_before_step(uint32_t id) {
-    const isa::Hart& h = threads_[id].hart;
-    const CodeRange* range = h.pc % 4 == 0 ? code_range_at(h.pc) : nullptr;
-    if (!range) return;  // a fetch fault reads nothing
-    const uint32_t index = (h.pc - range->base) / 4;
-    const isa::FuClass fu = decoded_[range->first + index].fu;
-    if (fu == isa::FuClass::Print ||
-        (fu == isa::FuClass::Load && !is_private(h, index, range->words, range->first)))
-        held_->write_through(position_of(id), memory_);
+    if (!next_is_private(id)) held_->write_through(position_of(id), memory_);
 }
 
 void Machine::write_held_before(uint64_t cycle) {
-    if (held_ && cycle != 0) held_->write_through(cycle * counter_lanes_.size() - 1, memory_);
+    if (held_ && cycle != 0) held_->write_through(position(cycle, 0) - 1, memory_);
 }
 
 Counters Machine::counters() const {

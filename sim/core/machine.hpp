@@ -217,10 +217,9 @@ private:
         return left;
     }
     [[noreturn]] void refuse_step(uint32_t id);
-    /// Timing mode, before run_ahead's first step (the chip's fetch, in its turn if the step
-    /// is not private): if the step reads shared memory (a load that is not private, a
-    /// print), every store held before it in the order is written. Cold: run_ahead calls it
-    /// only for a load or print.
+    /// Timing mode, before run_ahead's first step (the chip's fetch): if the step is not
+    /// private (a load of shared memory, a print), it is in its turn, and every store held
+    /// before it in the order is written. Cold: run_ahead calls it only for a load or print.
     [[gnu::cold]] void write_held_before_step(uint32_t id);
 
     // The synchronisation instructions and exit (ThreadEnv's hooks). Each returns what the
@@ -300,10 +299,14 @@ private:
     uint32_t cycle_stride_ = 0;
     /// Timing mode's stores, one producer per TM; none in functional mode.
     std::unique_ptr<HeldStores> held_;
-    /// Thread `id`'s place in the timing mode's order: its TM's cycle * TMs + its TM.
+    /// The timing mode's order, the chip's turns: TM `tm` in cycle `cycle`.
+    uint64_t position(uint64_t cycle, uint32_t tm) const {
+        return cycle * counter_lanes_.size() + tm;
+    }
+    /// Thread `id`'s place in that order: its TM at the cycle the TM is simulating.
     uint64_t position_of(uint32_t id) const {
         const uint32_t tm = id / config_.threads_per_tm;
-        return cycle_counters_[size_t(tm) * cycle_stride_] * counter_lanes_.size() + tm;
+        return position(cycle_counters_[size_t(tm) * cycle_stride_], tm);
     }
 };
 
