@@ -14,6 +14,7 @@
 #include "sim/core/fault.hpp"
 #include "sim/core/host_spacing.hpp"
 #include "sim/core/memory.hpp"
+#include "sim/core/ordered_turns.hpp"
 
 namespace tpsim::core {
 
@@ -301,7 +302,7 @@ private:
     std::unique_ptr<HeldStores> held_;
     /// The timing mode's order, the chip's turns: TM `tm` in cycle `cycle`.
     uint64_t position(uint64_t cycle, uint32_t tm) const {
-        return cycle * counter_lanes_.size() + tm;
+        return chip_position(cycle, tm, counter_lanes_.size());
     }
     /// Thread `id`'s place in that order: its TM at the cycle the TM is simulating.
     uint64_t position_of(uint32_t id) const {

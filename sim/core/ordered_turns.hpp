@@ -15,6 +15,12 @@
 
 namespace tpsim::core {
 
+/// The cycle-level chip's order, which its turns and the functional machine's held stores
+/// share: TM `tm` of `tms` in cycle `cycle`.
+constexpr uint64_t chip_position(uint64_t cycle, uint32_t tm, uint64_t tms) {
+    return cycle * tms + tm;
+}
+
 class OrderedTurns {
 public:
     /// Past every position: a lane that has finished (or stopped) waits for nothing more.

@@ -1114,11 +1114,12 @@ Chip::Progress Chip::tick_tms(uint32_t lane, uint32_t from, uint32_t to, uint64_
         for (uint32_t t = from; t < to; ++t) {
             Tm& tm = *tms_[t];
             if (tm.running == 0 || tm.ordered_from > now) continue;
-            if (tms_in_parallel_) host_threads_->turns.reach(lane, now * tms + t);
+            if (tms_in_parallel_)
+                host_threads_->turns.reach(lane, core::chip_position(now, t, tms));
             if (tm.fault_due) std::rethrow_exception(std::exchange(tm.fault_due, nullptr));
             tm_cycle(tm, now, source);
         }
-    if (tms_in_parallel_) host_threads_->turns.reach(lane, end * tms);
+    if (tms_in_parallel_) host_threads_->turns.reach(lane, core::chip_position(end, 0, tms));
     // Every TM that ticked in the stretch (one idle before it is the shared parts').
     Progress progress;
     for (uint32_t t = from; t < to; ++t)
@@ -1165,7 +1166,7 @@ bool Chip::tick_lane(uint32_t lane, uint32_t from, uint32_t to, uint64_t stretch
 
 void Chip::wait_turn(const Tm& tm, uint64_t now) {
     HostThreads& host = *host_threads_;
-    const uint64_t position = now * tms_.size() + tm.id;
+    const uint64_t position = core::chip_position(now, tm.id, tms_.size());
     if (!host.turns.passed(tm.lane, position)) {  // the time waited is not the lane's work
         const HostClock::time_point start = HostClock::now();
         host.turns.wait_turn(tm.lane, position);
