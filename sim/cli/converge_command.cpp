@@ -77,8 +77,7 @@ int run_converge(const ConvergeCommandOptions& o) {
         fmt::print(stderr, "tpsim: warning: {}\n", warning);
     };
     if (!o.config.empty()) base.chip = timing::load_config(o.config);
-    for (const std::string& assignment : o.overrides)
-        timing::apply_override(base.chip, assignment);
+    timing::apply_overrides(base.chip, o.overrides);
 
     for (size_t i = 0; i < o.spp.size(); ++i)
         if (std::count(o.spp.begin(), o.spp.end(), o.spp[i]) > 1)

@@ -96,8 +96,7 @@ int run_render(RenderCommandOptions& o) {
     options.max_item_instructions = o.max_item_instructions;
     options.timeline_interval = o.timeline_cycles;
     if (!o.config.empty()) options.chip = timing::load_config(o.config);
-    for (const std::string& assignment : o.overrides)
-        timing::apply_override(options.chip, assignment);
+    timing::apply_overrides(options.chip, o.overrides);
     options.bvh.builder = o.bvh == "binned"   ? scene::BvhBuilder::binned
                           : o.bvh == "median" ? scene::BvhBuilder::median
                                               : scene::BvhBuilder::sweep;

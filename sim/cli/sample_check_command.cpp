@@ -47,8 +47,7 @@ int run_sample_check(SampleCheckCommandOptions& o) {
     base.scene = o.scene;
     base.kernel = resolve_kernel(o.kernel);
     if (!o.config.empty()) base.chip = timing::load_config(o.config);
-    for (const std::string& assignment : o.overrides)
-        timing::apply_override(base.chip, assignment);
+    timing::apply_overrides(base.chip, o.overrides);
     base.image_width = o.width;
     base.image_height = o.height;
     base.samples_per_pixel = o.samples_per_pixel;

@@ -327,7 +327,11 @@ ChipConfig load_config(const std::string& path) {
     return parse_config(read_input_file(path, "chip config", kMaxConfigBytes), path, ChipConfig{});
 }
 
-void apply_override(ChipConfig& config, std::string_view assignment) {
+namespace {
+
+/// Sets the field one "key=value" assignment names, range-checking the value; the cross-field
+/// rules are left to validate(), which sees every override applied.
+void assign_override(ChipConfig& config, std::string_view assignment) {
     const std::string where = fmt::format("override '{}'", assignment);
     const size_t eq = assignment.find('=');
     if (eq == std::string_view::npos)
@@ -357,14 +361,31 @@ void apply_override(ChipConfig& config, std::string_view assignment) {
     const auto [real_end, real_ec] = std::from_chars(text.data(), text.data() + text.size(), real);
     if (!hex && real_ec == std::errc{} && real_end == text.data() + text.size() && !text.empty())
         value.as_real = real;
+    if (!assign(config, key, value, where)) unknown_key(where, key);
+}
+
+}  // namespace
+
+void apply_overrides(ChipConfig& config, std::span<const std::string> assignments) {
     ChipConfig updated = config;
-    if (!assign(updated, key, value, where)) unknown_key(where, key);
+    for (const std::string& assignment : assignments)
+        assign_override(updated, assignment);
     try {
         validate(updated);
     } catch (const ConfigError& e) {
-        throw ConfigError(fmt::format("{}: {}", where, e.what()));
+        std::vector<std::string> quoted;
+        for (const std::string& assignment : assignments)
+            quoted.push_back(fmt::format("'{}'", assignment));
+        throw ConfigError(fmt::format("{} {}: {}",
+                                      assignments.size() == 1 ? "override" : "overrides",
+                                      fmt::join(quoted, ", "), e.what()));
     }
     config = updated;
+}
+
+void apply_override(ChipConfig& config, std::string_view assignment) {
+    const std::string one(assignment);
+    apply_overrides(config, std::span(&one, 1));
 }
 
 std::string to_toml(const ChipConfig& config) {

@@ -3,6 +3,7 @@
 // overridable field by field, validated with messages naming the key and its allowed range.
 #pragma once
 #include <cstdint>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -239,7 +240,11 @@ ChipConfig load_config(const std::string& path);
 /// Parses TOML text (`source_name` appears in error messages) over `base`.
 ChipConfig parse_config(std::string_view toml_text, std::string_view source_name,
                         const ChipConfig& base = {});
-/// Applies one "key.path=value" override (e.g. "l1.size_bytes=16384") with full validation.
+/// Applies "key.path=value" overrides (e.g. "l1.size_bytes=16384") in order, then validates the
+/// result once, so that overrides which only agree together (dram.tRCD and dram.tRAS) are taken.
+/// Throws ConfigError naming the overrides; a rejected list leaves `config` untouched.
+void apply_overrides(ChipConfig& config, std::span<const std::string> assignments);
+/// apply_overrides() with one override.
 void apply_override(ChipConfig& config, std::string_view assignment);
 /// Checks every range and cross-field rule, and that a run fits in kMaxHostBytes
 /// (host_bytes); throws ConfigError naming the first violation.

@@ -95,6 +95,22 @@ TEST_CASE("overrides set one field with the same validation", "[config]") {
     CHECK(c == before);  // a rejected override leaves the config untouched
 }
 
+TEST_CASE("overrides are validated together, after all of them are applied", "[config]") {
+    // tRAS must be >= tRCD: raising both is one valid change, refused if checked one at a time.
+    ChipConfig c;
+    const std::vector<std::string> both = {"dram.tRCD=36", "dram.tRAS=84"};
+    apply_overrides(c, both);
+    CHECK(c.dram.tRCD == 36);
+    CHECK(c.dram.tRAS == 84);
+    // A list that stays invalid is refused whole, naming every override, the config untouched.
+    ChipConfig d;
+    const std::vector<std::string> bad = {"dram.tRAS=84", "dram.tRCD=90"};
+    CHECK_THROWS_WITH(apply_overrides(d, bad),
+                      Contains("overrides 'dram.tRAS=84', 'dram.tRCD=90'") &&
+                          Contains("dram.tRAS = 84 must be >= dram.tRCD = 90"));
+    CHECK(d == ChipConfig{});
+}
+
 TEST_CASE("the printed config lists every key and parses back to the same config", "[config]") {
     ChipConfig c;
     apply_override(c, "dram.tCL=20");
