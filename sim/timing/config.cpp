@@ -373,12 +373,9 @@ void apply_overrides(ChipConfig& config, std::span<const std::string> assignment
     try {
         validate(updated);
     } catch (const ConfigError& e) {
-        std::vector<std::string> quoted;
-        for (const std::string& assignment : assignments)
-            quoted.push_back(fmt::format("'{}'", assignment));
-        throw ConfigError(fmt::format("{} {}: {}",
+        throw ConfigError(fmt::format("{} '{}': {}",
                                       assignments.size() == 1 ? "override" : "overrides",
-                                      fmt::join(quoted, ", "), e.what()));
+                                      fmt::join(assignments, "', '"), e.what()));
     }
     config = updated;
 }
