@@ -3,6 +3,7 @@
 // (docs/course/README.md). Exit 0 when every check passes, 1 when one fails.
 #include <iostream>
 #include <memory>
+#include <set>
 #include <string>
 
 #include <fmt/format.h>
@@ -28,9 +29,7 @@ int run_check(const CheckCommandOptions& o) {
     const std::filesystem::path dir = course::find_assignment(o.course, o.assignment);
     const course::Assignment assignment = course::load_assignment(dir / "assignment.toml");
     std::error_code ec;
-    if (!std::filesystem::is_directory(o.output_dir, ec))
-        throw Error(
-            fmt::format("--output-dir '{}' is not a directory; create it first", o.output_dir));
+    make_output_dir(o.output_dir);
     course::CheckOptions options;
     options.kernel = o.kernel;
     if (!assignment.baseline.empty()) {
@@ -54,6 +53,12 @@ int run_check(const CheckCommandOptions& o) {
                                    assignment.baseline));
     };
     options.on_progress = [&](const render::Progress& p) { progress.update(p); };
+    std::set<std::string> warned;  // each scene's render warns again of the same kernel
+    options.on_warning = [&](const std::string& warning) {
+        if (!warned.insert(warning).second) return;
+        progress.clear();
+        fmt::print(stderr, "tpsim: warning: {}\n", warning);
+    };
 
     const course::CheckReport report = course::check(assignment, options);
     progress.clear();

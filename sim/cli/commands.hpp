@@ -59,6 +59,9 @@ inline CLI::Validator whole_number_in(uint32_t lo, uint32_t hi) {
 /// Throws tpsim::Error unless a file can be created at `path` (its directory exists); `what`
 /// names the file in the message ("the report").
 void check_output_path(const std::filesystem::path& path, const std::string& what);
+/// Makes the --output-dir folder (and its parents) unless it exists; throws tpsim::Error when it
+/// is a file or cannot be made.
+void make_output_dir(const std::filesystem::path& dir);
 /// Writes `text` to `path`, throwing tpsim::Error naming both on failure.
 void write_output(const std::filesystem::path& path, const std::string& text,
                   const std::string& what);

@@ -110,9 +110,7 @@ int run_converge(const ConvergeCommandOptions& o) {
     options.reference_spp =
         o.reference_spp != 0 ? o.reference_spp : std::clamp<uint32_t>(16 * most, 256, 65536);
 
-    if (!std::filesystem::is_directory(o.output_dir, ec))
-        throw Error(
-            fmt::format("--output-dir '{}' is not a directory; create it first", o.output_dir));
+    make_output_dir(o.output_dir);
     options.output_dir = o.output_dir;
     if (!o.json.empty()) check_output_path(o.json, "the results");
     if (!o.html.empty()) check_output_path(o.html, "the report");

@@ -17,6 +17,7 @@
 #include "sim/core/error.hpp"
 #include "sim/core/input_file.hpp"
 #include "sim/core/program.hpp"
+#include "sim/course/assignment.hpp"
 
 namespace tpsim::cli {
 namespace {
@@ -91,6 +92,18 @@ bool run(const std::vector<std::string>& args) {
     return ran.succeeded();
 }
 
+/// What `render` needs to show the kernel's image: an assignment's first scene at the size its
+/// checker renders, or the Cornell box. Absolute paths: the commands work from any folder.
+std::string scene_arguments(const fs::path& starter, const std::string& assignment) {
+    if (assignment.empty()) return (kSourceDir / "scenes" / "cornell.toml").string();
+    const course::Assignment a = course::load_assignment(starter.parent_path() / "assignment.toml");
+    std::string arguments = a.scenes.at(0).file.lexically_normal().string();
+    if (a.width != 0) arguments += fmt::format(" --width {}", a.width);
+    if (a.height != 0) arguments += fmt::format(" --height {}", a.height);
+    if (a.samples_per_pixel != 0) arguments += fmt::format(" --spp {}", a.samples_per_pixel);
+    return arguments;
+}
+
 int run_new_kernel(const NewKernelOptions& o) {
     const fs::path dir = o.dir;
     const std::string name = o.name.empty() ? name_from(dir) : o.name;
@@ -101,6 +114,7 @@ int run_new_kernel(const NewKernelOptions& o) {
     const fs::path starter = o.assignment.empty()
                                  ? kSourceDir / "kernel" / "template" / "kernel.cpp"
                                  : starter_of(o.assignment);
+    const std::string scene = scene_arguments(starter, o.assignment);
     std::error_code ec;
     if (fs::exists(dir, ec) && (!fs::is_directory(dir, ec) || !fs::is_empty(dir, ec)))
         throw Error(
@@ -116,6 +130,7 @@ int run_new_kernel(const NewKernelOptions& o) {
                                            "kernel template", kMaxTemplateBytes);
         text = substitute(text, "@NAME@", name);
         text = substitute(text, "@TPSIM_BUILD@", kBuildDir.string());
+        text = substitute(text, "@SCENE@", scene);
         text = substitute(text, "@TPSIM_SOURCE@", kSourceDir.string());
         return substitute(text, "@TPSIM@", tpsim.string());
     };
@@ -137,8 +152,8 @@ int run_new_kernel(const NewKernelOptions& o) {
                (build / "kernels" / ("lib" + name + "_native.so")).string(), starter.string());
     fmt::print("next     edit {}, then\n", (dir / "kernel.cpp").string());
     fmt::print("         cmake --build {}\n", build.string());
-    fmt::print("         {} render {} --kernel {} -o {}.png\n", tpsim.string(),
-               (kSourceDir / "scenes" / "cornell.toml").string(), elf.string(), name);
+    fmt::print("         {} render {} --kernel {} -o {}.png\n", tpsim.string(), scene, elf.string(),
+               name);
     if (!o.assignment.empty())
         fmt::print("         {} check {} --kernel {}\n", tpsim.string(), o.assignment,
                    elf.string());

@@ -18,6 +18,13 @@ void check_output_path(const std::filesystem::path& path, const std::string& wha
                                 what, path.string()));
 }
 
+void make_output_dir(const std::filesystem::path& dir) {
+    std::error_code ec;
+    if (std::filesystem::create_directories(dir, ec); ec || !std::filesystem::is_directory(dir))
+        throw Error(fmt::format("--output-dir '{}': cannot make the folder: {}", dir.string(),
+                                ec ? ec.message() : "a file of that name is in the way"));
+}
+
 void write_output(const std::filesystem::path& path, const std::string& text,
                   const std::string& what) {
     std::ofstream out(path, std::ios::binary);

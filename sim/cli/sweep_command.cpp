@@ -84,7 +84,7 @@ std::vector<sweep::Column> columns(const CollectOptions& c) {
             throw Error(fmt::format("--column '{}': give NAME=KEY (e.g. "
                                     "operand_stalls=chip/stalls/operand) or a statistic's KEY",
                                     spec));
-        list.push_back({name, key});
+        list.push_back({name, key, true});
     }
     return list;
 }

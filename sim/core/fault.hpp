@@ -58,20 +58,29 @@ private:
     std::shared_ptr<const trax::KernelOutput> output_;  ///< shared: exceptions are copied
 };
 
-/// The one-line, user-facing fault of a simulated thread.
+/// The one-line, user-facing fault of a simulated thread: "<problem>; <hint>".
 class Fault : public KernelError {
 public:
-    Fault(FaultKind kind, uint32_t thread, uint32_t pc, const std::string& message,
-          trax::KernelOutput output)
-        : KernelError(message, std::move(output)), kind_(kind), thread_(thread), pc_(pc) {}
+    Fault(FaultKind kind, uint32_t thread, uint32_t pc, const std::string& problem,
+          const std::string& hint, trax::KernelOutput output)
+        : KernelError(problem + "; " + hint, std::move(output)), kind_(kind), thread_(thread),
+          pc_(pc), problem_size_(problem.size()) {}
     FaultKind kind() const { return kind_; }
     uint32_t thread() const { return thread_; }
     uint32_t pc() const { return pc_; }
+    /// What went wrong and where, without the hint (for callers with a better one).
+    std::string problem() const { return std::string(what()).substr(0, problem_size_); }
+    std::string hint() const { return std::string(what()).substr(problem_size_ + 2); }
+    /// The same fault carrying what the kernel printed until `output` was taken.
+    Fault with_output(trax::KernelOutput output) const {
+        return Fault(kind_, thread_, pc_, problem(), hint(), std::move(output));
+    }
 
 private:
     FaultKind kind_;
     uint32_t thread_;
     uint32_t pc_;
+    size_t problem_size_;
 };
 
 }  // namespace tpsim::core

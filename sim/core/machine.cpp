@@ -101,10 +101,9 @@ void Machine::fault(uint32_t id, uint32_t pc, const GuestFault& what) {
                       what.kind != FaultKind::InstructionLimit;
     const std::string instruction = show ? isa::disassemble(word, pc) + " " : "";
     throw Fault(what.kind, id, pc,
-                fmt::format("{} in thread {} at pc {:#010x}{}: {}{}; {}", to_string(what.kind), id,
-                            pc, where.empty() ? "" : " (" + where + ")", instruction, what.detail,
-                            what.hint),
-                output_);
+                fmt::format("{} in thread {} at pc {:#010x}{}: {}{}", to_string(what.kind), id, pc,
+                            where.empty() ? "" : " (" + where + ")", instruction, what.detail),
+                what.hint, output_);
 }
 
 void Machine::fetch_fault(uint32_t id, uint32_t pc) {
@@ -321,8 +320,7 @@ void Machine::run_lanes(uint32_t lanes) {
             try {
                 throw;
             } catch (const Fault& f) {
-                error =
-                    std::make_exception_ptr(Fault(f.kind(), f.thread(), f.pc(), f.what(), output_));
+                error = std::make_exception_ptr(f.with_output(output_));
             } catch (...) {
             }
             failures[lane] = error;

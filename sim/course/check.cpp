@@ -174,6 +174,21 @@ Rgb8 difference_image(const Rgb8& image, const Rgb8& ref, int tolerance) {
     return out;
 }
 
+/// The image with each pixel a `factor` x `factor` square, to see single pixels of a small
+/// image on a screen.
+Rgb8 enlarged(const Rgb8& image, int factor) {
+    Rgb8 out{image.width * factor, image.height * factor, {}};
+    out.pixels.resize(size_t(out.width) * out.height * 3);
+    for (int y = 0; y < out.height; ++y)
+        for (int x = 0; x < out.width; ++x)
+            std::copy_n(&image.pixels[(size_t(y / factor) * image.width + x / factor) * 3], 3,
+                        &out.pixels[(size_t(y) * out.width + x) * 3]);
+    return out;
+}
+
+/// Difference images are enlarged to about this many pixels across.
+constexpr int kEnlargedWidth = 512;
+
 render::RenderOptions render_options(const Assignment& a, const AssignmentScene& scene,
                                      const CheckOptions& o) {
     render::RenderOptions r;
@@ -186,6 +201,7 @@ render::RenderOptions render_options(const Assignment& a, const AssignmentScene&
     if (a.chip_config) r.chip = timing::load_config(a.chip_config->string());
     r.max_item_instructions = a.max_pixel_instructions;
     r.on_progress = o.on_progress;
+    r.on_warning = o.on_warning;
     return r;
 }
 
@@ -336,10 +352,14 @@ CheckReport check(const Assignment& a, const CheckOptions& o) {
             // The kernel's own mistake: the assignment fails, with the simulator's words.
             const bool runaway = fault.kind() == core::FaultKind::InstructionLimit;
             std::string detail = fmt::format("the kernel stopped: {}", fault.what());
+            // The fault's own hint (raise the limit with a render flag) does not apply: the
+            // assignment sets the limit.
             if (runaway && a.max_pixel_instructions != 0)
-                detail = fmt::format("a pixel took more than {} instructions{}; {}",
-                                     number(double(a.max_pixel_instructions)),
-                                     a.slow_hint.empty() ? "" : " — " + a.slow_hint, fault.what());
+                detail =
+                    fmt::format("a pixel took more than {} instructions, the assignment's "
+                                "limit{}; {}",
+                                number(double(a.max_pixel_instructions)),
+                                a.slow_hint.empty() ? "" : " — " + a.slow_hint, fault.problem());
             report.results.push_back({scene.name, "run", false, detail});
             continue;
         }
@@ -382,9 +402,17 @@ CheckReport check(const Assignment& a, const CheckOptions& o) {
                 percent(c.differing_share), a.image.tolerance, percent(a.image.max_differing));
             if (!r.passed) r.detail += " — " + likely_cause(image, ref, c, a);
             report.results.push_back(std::move(r));
+            const Rgb8 difference = difference_image(image, ref, a.image.tolerance);
             const std::filesystem::path diff = o.output_dir / (stem + ".diff.png");
-            write_rgb8(diff, difference_image(image, ref, a.image.tolerance));
+            write_rgb8(diff, difference);
             report.files.push_back(diff);
+            if (const int factor = kEnlargedWidth / std::max(image.width, image.height);
+                factor > 1) {
+                const std::filesystem::path large =
+                    o.output_dir / fmt::format("{}.diff-x{}.png", stem, factor);
+                write_rgb8(large, enlarged(difference, factor));
+                report.files.push_back(large);
+            }
         }
         std::optional<render::RenderResult> baseline;
         if (needs_baseline(a, scene)) {

@@ -31,8 +31,10 @@ struct CheckOptions {
     std::function<void(size_t index, const AssignmentScene&)> on_scene;
     /// ... when the baseline kernel starts rendering it (for budgets with a ratio) ...
     std::function<void(const AssignmentScene&)> on_baseline;
-    /// ... and while either renders on the chip model.
+    /// ... while either renders on the chip model ...
     render::ProgressCallback on_progress;
+    /// ... and for what the renders warn of (a scene's, an ELF older than its source).
+    std::function<void(const std::string&)> on_warning;
 };
 
 struct CheckReport {

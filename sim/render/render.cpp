@@ -72,6 +72,20 @@ bool Kernel::defines(std::string_view symbol_name) const {
     return false;
 }
 
+std::string Kernel::stale_warning() const {
+    std::error_code ec;
+    const auto built = std::filesystem::last_write_time(elf, ec);
+    if (ec) return "";
+    for (const core::Program::SourceFile& source : program.line_files) {
+        const auto changed = std::filesystem::last_write_time(source.path, ec);
+        if (!ec && changed > built)
+            return fmt::format("{} is older than its source {}, changed since it was built: this "
+                               "runs the old kernel (did the last build fail?); build it again",
+                               elf.string(), source.path);
+    }
+    return "";
+}
+
 bool Kernel::uses_bvh() const {
     return defines(trax::layout::kUsesBvhSymbol);
 }
@@ -141,6 +155,8 @@ RenderResult render(const RenderOptions& options) {
     Kernel kernel = Kernel::load(options.kernel);
     kernel.set_params(options.params);
     result.params = kernel.params;
+    if (const std::string warning = kernel.stale_warning(); !warning.empty() && options.on_warning)
+        options.on_warning(warning);
     if (const std::string warning = check_stack(kernel, options.engine, options.chip);
         !warning.empty() && options.on_warning)
         options.on_warning(warning);
@@ -189,10 +205,11 @@ RenderResult render(const RenderOptions& options) {
     result.traversal = image::read_thread_stats(result.image.header, result.image.words.data());
     if (result.traversal.stack_overflows > 0) {
         const std::string message = fmt::format(
-            "the kernel's BVH traversal stack overflowed {} times: it holds {} entries but the BVH "
-            "is {} levels deep; build the BVH with traversal_stack_entries <= the kernel's stack",
-            result.traversal.stack_overflows, trax::layout::kTraversalStackEntries,
-            result.bvh ? result.bvh->max_depth : 0);
+            "the kernel's BVH traversal stack overflowed {} times: it filled at {} entries but the "
+            "BVH is {} levels deep; give the stack {} entries (trax::layout::"
+            "kTraversalStackEntries: tpsim builds no BVH deeper than a stack that size can walk)",
+            result.traversal.stack_overflows, result.traversal.max_stack_depth,
+            result.bvh ? result.bvh->max_depth : 0, trax::layout::kTraversalStackEntries);
         throw core::KernelError(message, std::move(result.output));
     }
     result.rgb = image::read_framebuffer(result.image.header, result.image.words.data());

@@ -65,6 +65,10 @@ struct Kernel {
     bool uses_extras() const;
     /// Does the ELF define a function (or code label) of this name?
     bool defines(std::string_view symbol_name) const;
+    /// A warning when a source file the ELF was compiled from (its DWARF line table names them)
+    /// changed after the ELF was written: the build that would have replaced it failed or was
+    /// not run, and the run is of the old kernel. Empty when the ELF is up to date.
+    std::string stale_warning() const;
 };
 
 struct RenderOptions {

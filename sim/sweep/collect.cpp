@@ -30,6 +30,23 @@ std::string readable(const std::optional<double>& value) {
     return stats::with_thousands(text);
 }
 
+/// "did you mean ..." for a mistyped key: the keys sharing its longest leading path.
+std::string suggestion(const std::string& key, const std::vector<std::string>& keys) {
+    for (std::string prefix = key; !prefix.empty();) {
+        const size_t slash = prefix.rfind('/');
+        prefix = slash == std::string::npos ? std::string() : prefix.substr(0, slash + 1);
+        std::vector<std::string> near;
+        for (const std::string& k : keys)
+            if (!prefix.empty() && k.starts_with(prefix) && near.size() < 4) near.push_back(k);
+        if (!near.empty())
+            return fmt::format("keys under '{}' are e.g. {}", prefix, fmt::join(near, ", "));
+        if (!prefix.empty()) prefix.pop_back();
+    }
+    return fmt::format(
+        "keys are e.g. {}",
+        fmt::join(keys.begin(), keys.begin() + std::min<size_t>(4, keys.size()), ", "));
+}
+
 }  // namespace
 
 std::vector<Column> default_columns() {
@@ -54,14 +71,21 @@ Table collect(const Sweep& sweep, const std::filesystem::path& dir,
         table.axes.push_back(axis.name);
     table.fixed = sweep.fixed;
     table.columns = columns;
+    std::vector<bool> found(columns.size(), false);
+    std::vector<std::string> keys;  // of the first finished job, to suggest from
     for (const Job& job : sweep.jobs) {
         Table::Row row{job.id, "missing", job.values, {}, std::nullopt};
         row.stats.resize(columns.size());
         if (finished(dir, job)) {
             const analysis::StatsFile run = analysis::load_stats_file(stats_path(dir, job.id));
             row.status = "ok";
-            for (size_t c = 0; c < columns.size(); ++c)
+            for (size_t c = 0; c < columns.size(); ++c) {
                 row.stats[c] = run.stat(columns[c].stat);
+                found[c] = found[c] || row.stats[c].has_value();
+            }
+            if (keys.empty())
+                for (const auto& stat : run.stats)
+                    keys.push_back(stat.first);
             double host = 0;
             bool any = false;
             for (const char* key : {"host/load_seconds", "host/bvh_seconds", "host/run_seconds"})
@@ -75,6 +99,12 @@ Table collect(const Sweep& sweep, const std::filesystem::path& dir,
         }
         table.rows.push_back(std::move(row));
     }
+    for (size_t c = 0; c < columns.size(); ++c)
+        if (columns[c].given && !found[c] && !keys.empty())
+            throw Error(fmt::format("--column {}={}: no finished job has the statistic '{}'; {} "
+                                    "(docs/statistics.md lists every key)",
+                                    columns[c].name, columns[c].stat, columns[c].stat,
+                                    suggestion(columns[c].stat, keys)));
     return table;
 }
 

@@ -124,6 +124,9 @@ std::string slurm_script(const Sweep& sweep, const std::filesystem::path& dir,
 struct Column {
     std::string name;  ///< e.g. "cycles"
     std::string stat;  ///< e.g. "chip/cycles"
+    /// Named by the user: a statistic that no finished job has is a mistake, not a blank column
+    /// (the default columns may be absent, e.g. cycles of a `--timing none` job).
+    bool given = false;
 };
 /// The table's statistics unless the user adds more (docs/sweeps.md).
 std::vector<Column> default_columns();

@@ -1149,8 +1149,7 @@ bool Chip::tick_lane(uint32_t lane, uint32_t from, uint32_t to, uint64_t stretch
             throw;
         } catch (const core::Fault& f) {
             if (clocked_machine_)
-                error = std::make_exception_ptr(core::Fault(f.kind(), f.thread(), f.pc(), f.what(),
-                                                            clocked_machine_->output()));
+                error = std::make_exception_ptr(f.with_output(clocked_machine_->output()));
         } catch (...) {
         }
         host.failures[lane] = {position, error};

@@ -291,6 +291,19 @@ l1.size_bytes = [4096, 8192]
           "l1.size_bytes");
     CHECK_THROWS_WITH(table_document(table, {{"energy"}, "bvh", ""}, "t"),
                       Catch::Contains("--metric energy: the table has no such column"));
+
+    // A column the user names must exist in the finished jobs' files: a typo is an error, not
+    // a column of "-". The default columns may be absent (no cycles without --timing cycles).
+    std::vector<Column> asked = default_columns();
+    asked.push_back({"bogus", "region/nope/x", true});
+    CHECK_THROWS_WITH(collect(sweep, results, asked),
+                      Catch::Contains("--column bogus=region/nope/x: no finished job has the "
+                                      "statistic 'region/nope/x'; keys under 'region/' are e.g."));
+    asked.back() = {"l1_reads", "region/camera/l1/reads", true};
+    CHECK(collect(sweep, results, asked).rows[0].stats.back().has_value());
+    asked.back().given = false;
+    asked.back().stat = "region/nope/x";
+    CHECK(!collect(sweep, results, asked).rows[0].stats.back().has_value());
 }
 
 TEST_CASE("sweep: the Slurm script runs each pending job as one array task", "[sweep]") {
