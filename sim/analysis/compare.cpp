@@ -323,7 +323,8 @@ void write_text(const Comparison& c, std::ostream& out, bool colour) {
             if (r) out << fmt::format(" {:>8}", run_letter(r) + "/A");
         }
         out << "\n";
-        for (const Row& row : section.rows) {
+        for (const Row& stored : section.rows) {
+            const Row row = for_display(stored);
             out << fmt::format("{:<{}}  {:<12}", row.key, key_width, row.unit);
             for (size_t r = 0; r < n; ++r) {
                 out << fmt::format(" {:>14}", format_cell(row.values[r]));
@@ -383,7 +384,8 @@ void write_markdown(const Comparison& c, std::ostream& out) {
             }
         }
         out << "\n" << rule << "\n";
-        for (const Row& row : section.rows) {
+        for (const Row& stored : section.rows) {
+            const Row row = for_display(stored);
             out << fmt::format("| `{}` | {} |", row.key, row.unit);
             for (size_t r = 0; r < n; ++r) {
                 out << " " << format_cell(row.values[r]) << " |";
@@ -514,6 +516,26 @@ std::string csv_field(const std::string& text) {
     for (char ch : text)
         quoted += ch == '"' ? std::string("\"\"") : std::string(1, ch);
     return quoted + "\"";
+}
+
+Row for_display(const Row& row) {
+    if (row.unit != "s" && row.unit != "J") return row;
+    double largest = 0;
+    for (const auto& v : row.values)
+        if (v && std::isfinite(*v)) largest = std::max(largest, std::abs(*v));
+    if (largest == 0 || largest >= 1) return row;
+    const struct {
+        double scale;
+        const char* prefix;
+    } prefixes[] = {{1e3, "m"}, {1e6, "µ"}, {1e9, "n"}};
+    const auto& chosen = largest >= 1e-3   ? prefixes[0]
+                         : largest >= 1e-6 ? prefixes[1]
+                                           : prefixes[2];
+    Row shown = row;
+    shown.unit = chosen.prefix + row.unit;
+    for (auto& v : shown.values)
+        if (v) *v *= chosen.scale;
+    return shown;
 }
 
 std::string format_number(double value) {

@@ -28,6 +28,10 @@ struct Row {
     bool differs_notably(size_t run) const;
 };
 
+/// The row as a person reads it: seconds and joules with the SI prefix that suits its largest
+/// value (2.85e-06 J -> 2.85 µJ); other units as they are. The CSV and JSON keep SI units.
+Row for_display(const Row& row);
+
 struct Section {
     std::string title;
     std::vector<Row> rows;

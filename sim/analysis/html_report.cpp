@@ -73,6 +73,9 @@ struct Chart {
     bool horizontal = false;
     bool percent = false;
     bool log = false;  ///< a logarithmic value axis
+    /// The value axis starts at 0 (bars of counts); false fits it to the data, so that the few
+    /// per cent by which compared designs differ can be seen.
+    bool zero = true;
     bool tall = false;
     std::string x_title = "";  ///< scatter: the x axis title
     bool x_log = false;        ///< scatter: a logarithmic x axis
@@ -95,11 +98,12 @@ struct Chart {
         return false;
     }
     Json to_json() const {
-        Json spec = {{"type", type},       {"title", title},
-                     {"unit", unit},       {"horizontal", horizontal},
-                     {"percent", percent}, {"log", log},
-                     {"xTitle", x_title},  {"xLog", x_log},
-                     {"labels", labels},   {"datasets", datasets}};
+        Json spec = {{"type", type},        {"title", title},
+                     {"unit", unit},        {"horizontal", horizontal},
+                     {"percent", percent},  {"log", log},
+                     {"zero", zero},        {"xTitle", x_title},
+                     {"xLog", x_log},       {"labels", labels},
+                     {"datasets", datasets}};
         if (range) spec["range"] = {range->first, range->second};
         return spec;
     }
@@ -547,12 +551,14 @@ void configuration(Page& page, const StatsFile& run) {
     page.body << "</table>\n</details>\n";
 }
 
+/// Each run's host time, named by its file when there are several.
 void host_line(Page& page, const std::vector<const StatsFile*>& runs) {
     std::string line;
     for (const StatsFile* run : runs)
         if (const auto seconds = run->stat("host/run_seconds"))
-            line += fmt::format("{}{}: {:.3f} s", line.empty() ? "" : ", ",
-                                escape(run->path.filename().string()), *seconds);
+            line += runs.size() == 1 ? fmt::format("{:.3f} s", *seconds)
+                                     : fmt::format("{}{}: {:.3f} s", line.empty() ? "" : ", ",
+                                                   escape(run->path.filename().string()), *seconds);
     if (!line.empty())
         page.body << "<p class=\"note\">Host wall time of the kernel run (the simulator's speed, "
                      "not a result): "
@@ -585,18 +591,21 @@ std::string distinct_part(const Section& section, const std::string& key) {
     return end > start ? key.substr(start, end - start) : key;
 }
 
-/// A grouped bar chart of rows from the comparison: one group per row, one bar per run.
+/// A grouped bar chart of rows from the comparison: one group per row, one bar per run; or,
+/// `relative`, one bar per run after A: its change against A in per cent (a bar from 0, so a
+/// 2 % difference shows as 2 % of the axis rather than as a sliver on a bar of 100 %).
 Chart grouped(const Comparison& c, const Section& section, std::string title, bool relative,
               double scale = 1) {
-    Chart chart{.title = std::move(title), .percent = scale == 100};
-    if (relative) chart.unit = "relative to A";
+    Chart chart{.title = std::move(title), .percent = relative || scale == 100};
+    if (relative) chart.unit = "change against A";
     for (const Row& row : section.rows)
         chart.labels.push_back(distinct_part(section, row.key));
-    for (size_t r = 0; r < c.runs.size(); ++r) {
+    for (size_t r = relative ? 1 : 0; r < c.runs.size(); ++r) {
         Json data = Json::array();
         for (const Row& row : section.rows) {
             const auto v = relative ? row.ratio(r) : row.values[r];
-            data.push_back(v && std::isfinite(*v) ? Json(scale * *v) : Json(0));
+            const double shown = relative && v ? 100 * (*v - 1) : v ? scale * *v : 0;
+            data.push_back(std::isfinite(shown) ? Json(shown) : Json(0));
         }
         chart.add(run_letter(r), data);
     }
@@ -640,13 +649,15 @@ std::string load_chart_js() {
                             kChartJsCandidates[0], kChartJsCandidates[1]));
 }
 
-std::string report_page(const StatsFile& run, const std::string& chart_js) {
+std::string report_page(const StatsFile& run, const std::string& chart_js,
+                        const std::string& source) {
     Page page;
     const std::string scene = run.run_text("scene");
-    page.body << fmt::format("<h1>tpsim report: {}</h1>\n<p class=\"sub\">{}</p>\n"
-                             "<p class=\"sub\">statistics file {}</p>\n",
-                             escape(scene.empty() ? run.path.filename().string() : scene),
-                             run_line(run), escape(run.path.string()));
+    page.body << fmt::format(
+        "<h1>tpsim report: {}</h1>\n<p class=\"sub\">{}</p>\n"
+        "<p class=\"sub\">{}</p>\n",
+        escape(scene.empty() ? run.path.filename().string() : scene), run_line(run),
+        escape(source.empty() ? "statistics file " + run.path.string() : source));
     cards(page, run);
     sampling(page, run);
     const auto image = run.run_file("image");
@@ -724,13 +735,13 @@ std::string comparison_page(const std::vector<StatsFile>& runs, const Comparison
     }
     page.body << "<h2>Side by side</h2>\n<div class=\"charts\">\n";
     if (const Section* s = find_section(c, "summary"))
-        page.chart(grouped(c, *s, "Summary, relative to A", true));
+        page.chart(grouped(c, *s, "Summary: change against A", true));
     if (const Section* s = find_section(c, "stall causes"))
         page.chart(grouped(c, *s, "Stall causes (TP-cycles)", false));
     if (const Section* s = find_section(c, "FU utilisation"))
         page.chart(grouped(c, *s, "Functional-unit utilisation", false, 100));
     if (const Section* s = find_section(c, "per ray"))
-        page.chart(grouped(c, *s, "Per ray, relative to A", true));
+        page.chart(grouped(c, *s, "Per ray: change against A", true));
     if (const Section* s = find_section(c, "energy by part"))
         page.chart(grouped(c, *s, "Energy by part (J)", false));
     if (const Section* s = find_section(c, "area by part"))
@@ -755,7 +766,8 @@ std::string comparison_page(const std::vector<StatsFile>& runs, const Comparison
             page.body << "<th class=\"num\">" << run_letter(r) << "</th>"
                       << (r ? "<th class=\"num\">" + run_letter(r) + "/A</th>" : "");
         page.body << "</tr>\n";
-        for (const Row& row : section.rows) {
+        for (const Row& stored : section.rows) {
+            const Row row = for_display(stored);
             page.body << "<tr><td class=\"code\">" << escape(row.key) << "</td><td>"
                       << escape(row.unit) << "</td>";
             for (size_t r = 0; r < runs.size(); ++r) {
@@ -1083,6 +1095,7 @@ void pareto_charts(Page& page, const Json& doc, size_t scene_axis) {
     struct Point {
         double ms, mj;
         std::string label;
+        size_t tag;  ///< the number the chart draws beside the point, and the table's first column
     };
     std::vector<std::pair<std::string, std::vector<Point>>> scenes;  // in row order
     for (const Json& row : doc["rows"]) {
@@ -1097,8 +1110,9 @@ void pareto_charts(Page& page, const Json& doc, size_t scene_axis) {
         auto found = std::find_if(scenes.begin(), scenes.end(),
                                   [&](const auto& s) { return s.first == scene; });
         if (found == scenes.end()) found = scenes.insert(scenes.end(), {scene, {}});
+        const size_t tag = found->second.size() + 1;
         found->second.push_back({t.get<double>() * 1e3, e.get<double>() * 1e3,
-                                 label.empty() ? row.value("id", "") : label});
+                                 label.empty() ? row.value("id", "") : label, tag});
     }
     if (scenes.empty()) return;
     page.body << "<h2>Frame time against energy</h2>\n<p class=\"note\">Each point is a job; the "
@@ -1112,7 +1126,7 @@ void pareto_charts(Page& page, const Json& doc, size_t scene_axis) {
                     .x_title = "frame time (ms)"};
         Json all = Json::array(), front = Json::array();
         for (const Point& p : points)
-            all.push_back({{"x", p.ms}, {"y", p.mj}, {"label", p.label}});
+            all.push_back({{"x", p.ms}, {"y", p.mj}, {"label", p.label}, {"tag", p.tag}});
         std::stable_sort(points.begin(), points.end(), [](const Point& a, const Point& b) {
             return a.ms < b.ms || (a.ms == b.ms && a.mj < b.mj);
         });
@@ -1127,6 +1141,20 @@ void pareto_charts(Page& page, const Json& doc, size_t scene_axis) {
         page.chart(chart);
     }
     page.body << "</div>\n";
+    // What each numbered point is, so that a screenshot says it without tooltips.
+    for (auto& [scene, points] : scenes) {
+        std::sort(points.begin(), points.end(),
+                  [](const Point& a, const Point& b) { return a.tag < b.tag; });
+        page.body << "<table><tr><th class=\"num\">point</th><th>"
+                  << (scene.empty() ? "job" : "job (" + escape(scene) + ")")
+                  << "</th><th class=\"num\">frame ms</th><th class=\"num\">energy mJ</th></tr>\n";
+        for (const Point& p : points)
+            page.body << fmt::format("<tr><td class=\"num\">{}</td><td>{}</td><td "
+                                     "class=\"num\">{}</td><td class=\"num\">{}</td></tr>\n",
+                                     p.tag, escape(p.label), format_number(p.ms),
+                                     format_number(p.mj));
+        page.body << "</table>\n";
+    }
 }
 
 std::string sweep_page(const Json& doc, const std::string& chart_js) {
@@ -1194,6 +1222,7 @@ std::string sweep_page(const Json& doc, const std::string& chart_js) {
             Chart chart{.type = numeric_x ? "line" : "bar",
                         .title = metric + (panel.empty() ? "" : " (" + panel + ")"),
                         .unit = metric,
+                        .zero = false,
                         .x_title = axes[x_axis]};
             chart.labels = x_labels;
             std::vector<std::string> series;
@@ -1228,18 +1257,40 @@ std::string sweep_page(const Json& doc, const std::string& chart_js) {
     for (const std::string& axis : axes)
         page.body << "<th>" << escape(axis) << "</th>";
     page.body << "<th>status</th>";
-    for (const Json& c : columns)
-        page.body << "<th class=\"num\" title=\"" << escape(c.value("stat", "")) << "\">"
-                  << escape(c.value("name", "")) << "</th>";
+    // Seconds and joules with one SI prefix per column, as the charts and compare show them;
+    // the header names the prefixed unit (the column's name says the SI one).
+    std::vector<Row> shown;
+    for (size_t c = 0; c < columns.size(); ++c) {
+        Row column{columns[c].value("name", ""), columns[c].value("unit", ""), Better::neutral, {}};
+        for (const Json& row : rows) {
+            const Json& value = row["stats"][c];
+            column.values.push_back(value.is_number() ? std::optional(value.get<double>())
+                                                      : std::nullopt);
+        }
+        shown.push_back(for_display(column));
+        page.body << "<th class=\"num\" title=\"" << escape(columns[c].value("stat", "")) << "\">"
+                  << escape(shown[c].key)
+                  << (shown[c].unit == column.unit ? "" : " (" + escape(shown[c].unit) + ")")
+                  << "</th>";
+    }
     page.body << "<th class=\"num\">host s</th></tr>\n";
-    for (const Json& row : rows) {
-        page.body << "<tr><td class=\"code\">" << escape(row.value("id", "")) << "</td>";
-        for (const Json& value : row["values"])
-            page.body << "<td>" << escape(text(value)) << "</td>";
+    for (size_t r = 0; r < rows.size(); ++r) {
+        const Json& row = rows[r];
+        page.body << "<tr><td class=\"code id\">" << escape(row.value("id", "")) << "</td>";
+        // A path (a scene, a mesh) by its file name, in full on hover.
+        for (const Json& value : row["values"]) {
+            const std::string full = text(value);
+            const std::string name = std::filesystem::path(full).filename().string();
+            if (value.is_string() && full.find('/') != std::string::npos && !name.empty())
+                page.body << "<td title=\"" << escape(full) << "\">" << escape(name) << "</td>";
+            else
+                page.body << "<td>" << escape(full) << "</td>";
+        }
         page.body << "<td>" << escape(row.value("status", "")) << "</td>";
-        for (const Json& value : row["stats"])
-            page.body << "<td class=\"num\">"
-                      << (value.is_number() ? readable(value.get<double>()) : "-") << "</td>";
+        for (const Row& column : shown) {
+            const auto& value = column.values[r];
+            page.body << "<td class=\"num\">" << (value ? readable(*value) : "-") << "</td>";
+        }
         const Json& host = row["host_seconds"];
         page.body << "<td class=\"num\">"
                   << (host.is_number() ? fmt::format("{:.2f}", host.get<double>()) : "-")

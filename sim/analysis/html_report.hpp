@@ -15,7 +15,10 @@ namespace tpsim::analysis {
 std::string load_chart_js();
 
 /// The report of one run.
-std::string report_page(const StatsFile& run, const std::string& chart_js);
+/// `source` says where the statistics are kept, in the page's header: by default "statistics
+/// file <run.path>"; `render --html` names its --stats-json file, or says there is none.
+std::string report_page(const StatsFile& run, const std::string& chart_js,
+                        const std::string& source = "");
 
 /// The runs side by side, with grouped bar charts; `comparison` is compare(runs).
 std::string comparison_page(const std::vector<StatsFile>& runs, const Comparison& comparison,

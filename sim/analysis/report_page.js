@@ -65,6 +65,34 @@
             });
         }
     };
+    // Points with a tag, {x, y, tag}, get it written beside them (the Pareto charts number
+    // their jobs; a table under the charts says which is which).
+    const pointTags = {
+        id: 'pointTags',
+        afterDatasetsDraw: function (chart) {
+            const ctx = chart.ctx;
+            ctx.save();
+            ctx.font = '11px system-ui, sans-serif';
+            ctx.fillStyle = '#1f2430';
+            // Points drawn on (or next to) each other share one label: "3, 4".
+            const placed = [];
+            chart.data.datasets.forEach(function (dataset, k) {
+                const meta = chart.getDatasetMeta(k);
+                if (meta.hidden) return;
+                dataset.data.forEach(function (p, i) {
+                    if (p === null || typeof p !== 'object' || p.tag === undefined) return;
+                    const x = meta.data[i].x, y = meta.data[i].y;
+                    const near = placed.find(function (q) {
+                        return Math.abs(q.x - x) < 8 && Math.abs(q.y - y) < 8;
+                    });
+                    if (near) near.text += ', ' + p.tag;
+                    else placed.push({ x: x, y: y, text: String(p.tag) });
+                });
+            });
+            placed.forEach(function (q) { ctx.fillText(q.text, q.x + 6, q.y - 6); });
+            ctx.restore();
+        }
+    };
     // The value range the error bars need (Chart.js scales to the points' y alone), or the one
     // the page chose (spec.range: [min, max]).
     function barRange(spec) {
@@ -83,7 +111,8 @@
         const scatter = spec.type === 'scatter';
         const valueAxis = Object.assign({
             type: spec.log ? 'logarithmic' : 'linear',
-            beginAtZero: !spec.log && !scatter,
+            beginAtZero: spec.zero && !spec.log && !scatter,
+            grace: spec.zero ? 0 : '8%',
             title: { display: !!spec.unit, text: spec.unit },
             ticks: spec.percent ? { callback: function (v) { return v + ' %'; } } : {},
             // Errors are read against 0, the true value: its grid line stands out.
@@ -130,7 +159,7 @@
                          showLine: spec.type !== 'scatter' || !!d.line };
             });
             new Chart(canvas, { type: spec.type, data: { labels: spec.labels, datasets: datasets },
-                                options: options(spec), plugins: [errorBars] });
+                                options: options(spec), plugins: [errorBars, pointTags] });
             const shown = datasets.findIndex(function (d) { return nonzero(d); });
             if (shown < 0 || !showsColour(canvas, datasets[shown].backgroundColor))
                 throw new Error('no data drawn');

@@ -180,9 +180,13 @@ int run_render(RenderCommandOptions& o) {
         // The page is made from the statistics file, as `tpsim report` makes it.
         const std::string document =
             render::stats_document(options, result, statistics, o.html, outputs).dump();
-        write_output(o.html,
-                     analysis::report_page(analysis::parse_stats_file(document, o.html), chart_js),
-                     "the report");
+        const std::string source =
+            o.stats_json.empty() ? "no statistics file (render with --stats-json FILE to keep one)"
+                                 : "statistics file " + o.stats_json;
+        write_output(
+            o.html,
+            analysis::report_page(analysis::parse_stats_file(document, o.html), chart_js, source),
+            "the report");
         fmt::print("report   {}\n", o.html);
     }
     return 0;

@@ -224,11 +224,11 @@ void register_stats(const RenderResult& r, stats::Registry& reg) {
         return t.rays() > 0 ? double(count) / double(t.rays()) : 0.0;
     };
     number(
-        "rays/total", [&t] { return t.rays(); }, "rays traced (primary + shadow)");
+        "rays/total", [&t] { return t.rays(); }, "rays traced (primary + shadow)", "rays");
     number(
-        "rays/primary", [&t] { return t.primary_rays; }, "closest-hit (camera) rays");
+        "rays/primary", [&t] { return t.primary_rays; }, "closest-hit (camera) rays", "rays");
     number(
-        "rays/shadow", [&t] { return t.shadow_rays; }, "any-hit (shadow) rays");
+        "rays/shadow", [&t] { return t.shadow_rays; }, "any-hit (shadow) rays", "rays");
     number(
         "traversal/nodes_per_ray", [&t, per_ray] { return per_ray(t.nodes_visited); },
         "BVH node boxes tested per ray, on average", "nodes");
@@ -240,15 +240,18 @@ void register_stats(const RenderResult& r, stats::Registry& reg) {
         "most traversal-stack entries any ray used", "entries");
 
     if (r.instructions.total > 0) {
-        reg.add_counter("instructions/total", r.instructions.total, "instructions executed");
+        reg.add_counter("instructions/total", r.instructions.total, "instructions executed",
+                        "instructions");
         for (size_t fu = 0; fu < r.instructions.per_fu.size(); ++fu)
             if (r.instructions.per_fu[fu] != 0)
                 reg.add_counter(fmt::format("instructions/fu/{}", isa::to_string(isa::FuClass(fu))),
-                                r.instructions.per_fu[fu], "instructions of this FU class");
+                                r.instructions.per_fu[fu], "instructions of this FU class",
+                                "instructions");
         for (size_t op = 0; op < r.instructions.per_op.size(); ++op)
             if (r.instructions.per_op[op] != 0)
                 reg.add_counter(fmt::format("instructions/op/{}", isa::info(isa::Op(op)).mnemonic),
-                                r.instructions.per_op[op], "instructions with this opcode");
+                                r.instructions.per_op[op], "instructions with this opcode",
+                                "instructions");
         const energy::RegisterAccesses rf = energy::register_accesses(r.instructions.per_op);
         number(
             "registers/reads", [rf] { return rf.reads; },

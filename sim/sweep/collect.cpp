@@ -82,6 +82,8 @@ Table collect(const Sweep& sweep, const std::filesystem::path& dir,
             for (size_t c = 0; c < columns.size(); ++c) {
                 row.stats[c] = run.stat(columns[c].stat);
                 found[c] = found[c] || row.stats[c].has_value();
+                if (table.columns[c].unit.empty())
+                    table.columns[c].unit = run.unit(columns[c].stat);
             }
             if (keys.empty())
                 for (const auto& stat : run.stats)
@@ -194,7 +196,7 @@ Json table_document(const Table& table, const ChartChoice& charts, const std::st
     for (const Setting& s : table.fixed)
         fixed[s.name] = s.value;
     for (const Column& c : table.columns)
-        columns.push_back({{"name", c.name}, {"stat", c.stat}});
+        columns.push_back({{"name", c.name}, {"stat", c.stat}, {"unit", c.unit}});
     for (const Table::Row& row : table.rows) {
         Json stats = Json::array();
         for (const auto& s : row.stats)

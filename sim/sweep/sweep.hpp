@@ -127,6 +127,7 @@ struct Column {
     /// Named by the user: a statistic that no finished job has is a mistake, not a blank column
     /// (the default columns may be absent, e.g. cycles of a `--timing none` job).
     bool given = false;
+    std::string unit = "";  ///< as the finished jobs' statistics files give it (collect fills it)
 };
 /// The table's statistics unless the user adds more (docs/sweeps.md).
 std::vector<Column> default_columns();

@@ -190,7 +190,7 @@ void Cache::register_stats(stats::Registry& r, std::string_view prefix) const {
     r.add_counter(name("mshr_full"), counters_.mshr_full, "loads refused for lack of an MSHR",
                   "accesses");
     r.add_counter(name("evictions"), counters_.evictions, "valid lines replaced", "lines");
-    r.add_ratio(name("hit_rate"), name("hits"), name("reads"), "hits / reads");
+    r.add_ratio(name("hit_rate"), name("hits"), name("reads"), "hits / reads", "ratio");
 }
 
 }  // namespace tpsim::timing

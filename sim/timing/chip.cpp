@@ -1588,11 +1588,12 @@ void Chip::register_stats(stats::Registry& r) const {
     r.add_formula(
         "chip/fps", {"chip/cycles"}, [clock_hz](Values v) { return v[0] ? clock_hz / v[0] : 0; },
         "frames per second if one run is one frame", "1/s");
-    r.add_sum("chip/instructions", "*/instructions", "instructions issued, all TMs");
+    r.add_sum("chip/instructions", "*/instructions", "instructions issued, all TMs",
+              "instructions");
     r.add_formula(
         "chip/issue_rate", {"chip/instructions", "chip/cycles"},
         [threads](Values v) { return v[1] ? v[0] / (v[1] * threads) : 0.0; },
-        "instructions per thread per cycle (1 = every TP issues every cycle)");
+        "instructions per thread per cycle (1 = every TP issues every cycle)", "ratio");
     r.add_sum("chip/active_tp_cycles", "*/active_tp_cycles", "TP-cycles before exit, all TMs",
               "TP-cycles");
     for (std::string_view stall : stall_names)
@@ -1627,7 +1628,7 @@ void Chip::register_stats(stats::Registry& r) const {
             r.add_sum(fmt::format("chip/{}/{}", level, leaf), from + std::string(leaf),
                       fmt::format("{} {}, all caches", level, leaf), "accesses");
         r.add_ratio(fmt::format("chip/{}/hit_rate", level), fmt::format("chip/{}/hits", level),
-                    fmt::format("chip/{}/reads", level), "hits / reads");
+                    fmt::format("chip/{}/reads", level), "hits / reads", "ratio");
     }
     r.add_formula(
         "chip/dram/bandwidth_bytes_per_cycle",
