@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fnmatch.h>
+#include <limits>
 #include <ostream>
 #include <set>
 
@@ -29,21 +30,28 @@ void add_unique(std::vector<std::string>& list, const std::string& item) {
 }
 
 Row stat_row(const std::vector<StatsFile>& runs, const std::string& key, Better better) {
-    Row row{key, "", better, {}};
+    Row row{key, "", better, {}, {}};
     for (const StatsFile& run : runs) {
         row.values.push_back(run.stat(key));
+        row.intervals.push_back(run.interval(key));
         if (row.unit.empty()) row.unit = run.unit(key);
     }
     return row;
 }
 
-/// A figure computed from others in each run (absent where a part is absent or divides by 0).
+/// A figure computed from the statistics `inputs` of each run (absent where a part is absent
+/// or divides by 0): exact when they all are, otherwise an estimate of unknown interval.
 template <class Derive>
 Row derived_row(const std::vector<StatsFile>& runs, std::string key, std::string unit,
-                Better better, Derive derive) {
-    Row row{std::move(key), std::move(unit), better, {}};
-    for (const StatsFile& run : runs)
+                Better better, std::initializer_list<std::string> inputs, Derive derive) {
+    Row row{std::move(key), std::move(unit), better, {}, {}};
+    for (const StatsFile& run : runs) {
         row.values.push_back(derive(run));
+        const bool exact = std::all_of(inputs.begin(), inputs.end(), [&](const std::string& in) {
+            return run.interval(in) == 0;
+        });
+        row.intervals.push_back(exact ? 0.0 : std::numeric_limits<double>::quiet_NaN());
+    }
     return row;
 }
 
@@ -75,6 +83,20 @@ std::vector<std::string> keys_like(const std::vector<StatsFile>& runs, std::stri
             if (middle.find('/') == std::string_view::npos) add_unique(keys, name);
         }
     return keys;
+}
+
+/// What a sampled run's figures are; empty for measured ones.
+std::string estimates_note(const StatsFile& run) {
+    if (!run.estimated()) return "";
+    const Json& s = *run.sampling;
+    std::string note = fmt::format(
+        "sampled (--timing sampled): its cycle-level figures are estimates, ± the half-width of "
+        "their {:g} % confidence interval, from {} units at rate {:g}",
+        100 * s.value("confidence", 0.95), s.value("units", 0), s.value("rate", 0.0));
+    if (s.value("too_few_units", false))
+        note += fmt::format("; fewer than {} units: the intervals are likely too narrow",
+                            s.value("trusted_units", 30));
+    return note;
 }
 
 Section summary_section(const std::vector<StatsFile>& runs) {
@@ -157,7 +179,8 @@ Section traffic_section(const std::vector<StatsFile>& runs) {
                 if (has_nonzero(row)) s.rows.push_back(std::move(row));
             }
             Row hit_rate = derived_row(
-                runs, prefix + "hit_rate", "ratio", Better::higher, [&](const StatsFile& run) {
+                runs, prefix + "hit_rate", "ratio", Better::higher,
+                {prefix + "hits", prefix + "reads"}, [&](const StatsFile& run) {
                     return quotient(run.stat(prefix + "hits"), run.stat(prefix + "reads"));
                 });
             if (has_any(hit_rate)) s.rows.push_back(std::move(hit_rate));
@@ -167,11 +190,13 @@ Section traffic_section(const std::vector<StatsFile>& runs) {
 
 Section per_ray_section(const std::vector<StatsFile>& runs) {
     Section s{"per ray", {}};
-    s.rows.push_back(derived_row(
-        runs, "per_ray/instructions", "instructions", Better::lower, [](const StatsFile& run) {
-            return quotient(run.stat("instructions/total"), run.stat("rays/total"));
-        }));
+    s.rows.push_back(derived_row(runs, "per_ray/instructions", "instructions", Better::lower,
+                                 {"instructions/total", "rays/total"}, [](const StatsFile& run) {
+                                     return quotient(run.stat("instructions/total"),
+                                                     run.stat("rays/total"));
+                                 }));
     s.rows.push_back(derived_row(runs, "per_ray/dram_bytes", "B", Better::lower,
+                                 {"dram/bytes_read", "dram/bytes_written", "rays/total"},
                                  [](const StatsFile& run) -> std::optional<double> {
                                      const auto read = run.stat("dram/bytes_read");
                                      const auto written = run.stat("dram/bytes_written");
@@ -269,6 +294,28 @@ std::string format_cell(std::optional<double> value) {
     return value ? format_number(*value) : "-";
 }
 
+/// A value with its interval when it is an estimate: "1592403 ±1130", "0.9415 ±?" (unknown).
+std::string estimate_cell(const Row& row, size_t run) {
+    const std::string value = format_cell(row.values[run]);
+    if (!row.values[run] || !row.estimated(run)) return value;
+    const double half = row.interval(run);
+    return value + (std::isnan(half) ? " ±?" : " ±" + format_number(half));
+}
+
+/// The ratio, marked "~" when the estimates' intervals cannot tell the two values apart.
+std::string ratio_text(const Row& row, size_t run) {
+    return format_ratio(row.ratio(run)) + (row.within_intervals(run) ? "~" : "");
+}
+
+bool any_estimates(const Comparison& c) {
+    return std::any_of(c.estimates.begin(), c.estimates.end(),
+                       [](const std::string& note) { return !note.empty(); });
+}
+
+constexpr const char* kWithinNote =
+    "~ after a ratio: the two values differ by less than their intervals together, so the "
+    "estimates cannot tell them apart";
+
 std::string run_letter(size_t run) {
     return run < 26 ? std::string(1, char('A' + run)) : fmt::format("R{}", run + 1);
 }
@@ -292,6 +339,12 @@ void write_text(const Comparison& c, std::ostream& out, bool colour) {
     const size_t n = c.runs.size();
     for (size_t i = 0; i < n; ++i)
         out << fmt::format("{:<10}{}  {}\n", i == 0 ? "runs" : "", run_letter(i), c.runs[i]);
+    for (size_t i = 0, shown = 0; i < n; ++i)
+        if (!c.estimates[i].empty())
+            out << fmt::format("{:<10}{}  {}\n", shown++ == 0 ? "estimates" : "", run_letter(i),
+                               c.estimates[i]);
+    // Estimates need room for their intervals and the "~" of their ratios.
+    const size_t cell = any_estimates(c) ? 24 : 14, ratio_width = any_estimates(c) ? 9 : 8;
     if (c.differences.empty())
         out << fmt::format("{:<10}none in run fields or configuration\n", "differs");
     for (size_t i = 0; i < c.differences.size(); ++i) {
@@ -319,23 +372,24 @@ void write_text(const Comparison& c, std::ostream& out, bool colour) {
             key_width = std::max(key_width, row.key.size());
         out << fmt::format("\n{:<{}}  {:<12}", section.title, key_width, "unit");
         for (size_t r = 0; r < n; ++r) {
-            out << fmt::format(" {:>14}", run_letter(r));
-            if (r) out << fmt::format(" {:>8}", run_letter(r) + "/A");
+            out << fmt::format(" {:>{}}", run_letter(r), cell);
+            if (r) out << fmt::format(" {:>{}}", run_letter(r) + "/A", ratio_width);
         }
         out << "\n";
         for (const Row& stored : section.rows) {
             const Row row = for_display(stored);
             out << fmt::format("{:<{}}  {:<12}", row.key, key_width, row.unit);
             for (size_t r = 0; r < n; ++r) {
-                out << fmt::format(" {:>14}", format_cell(row.values[r]));
+                out << fmt::format(" {:>{}}", estimate_cell(row, r), cell);
                 if (r == 0) continue;
-                const std::string cell = fmt::format(" {:>8}", format_ratio(row.ratio(r)));
+                const std::string ratio = fmt::format(" {:>{}}", ratio_text(row, r), ratio_width);
                 const char* ansi = colour ? colour_of(row, r) : nullptr;
-                out << (ansi ? ansi + cell + "\033[0m" : cell);
+                out << (ansi ? ansi + ratio + "\033[0m" : ratio);
             }
             out << "\n";
         }
     }
+    if (any_estimates(c)) out << "\n" << kWithinNote << "\n";
 }
 
 void write_markdown(const Comparison& c, std::ostream& out) {
@@ -344,6 +398,9 @@ void write_markdown(const Comparison& c, std::ostream& out) {
     for (size_t i = 0; i < n; ++i)
         out << fmt::format("| {} | `{}` |\n", run_letter(i), c.runs[i]);
     out << "\n";
+    for (size_t i = 0; i < n; ++i)
+        if (!c.estimates[i].empty())
+            out << fmt::format("Run {} is {}.\n\n", run_letter(i), c.estimates[i]);
     if (!c.differences.empty()) {
         out << "| differs |";
         for (size_t r = 0; r < n; ++r)
@@ -388,13 +445,14 @@ void write_markdown(const Comparison& c, std::ostream& out) {
             const Row row = for_display(stored);
             out << fmt::format("| `{}` | {} |", row.key, row.unit);
             for (size_t r = 0; r < n; ++r) {
-                out << " " << format_cell(row.values[r]) << " |";
-                if (r) out << " " << format_ratio(row.ratio(r)) << " |";
+                out << " " << estimate_cell(row, r) << " |";
+                if (r) out << " " << ratio_text(row, r) << " |";
             }
             out << "\n";
         }
         out << "\n";
     }
+    if (any_estimates(c)) out << kWithinNote << ".\n";
 }
 
 /// Exact figures for machines: integers in full, reals in the shortest round-trip form.
@@ -405,16 +463,19 @@ std::string csv_number(std::optional<double> value) {
 
 void write_csv(const Comparison& c, std::ostream& out) {
     const size_t n = c.runs.size();
+    // A sampled run's column is followed by its intervals' half-widths (empty: unknown).
+    const auto sampled = [&](size_t r) { return !c.estimates[r].empty(); };
     out << "section,key,unit";
     for (size_t r = 0; r < n; ++r) {
         out << "," << csv_field(c.runs[r]);
+        if (sampled(r)) out << "," << csv_field(c.runs[r] + " ±");
         if (r) out << "," << csv_field(c.runs[r] + " / " + c.runs[0]);
     }
     out << "\n";
     for (const SetupDifference& d : c.differences) {
         out << "setup," << csv_field(d.field) << ",";
         for (size_t r = 0; r < n; ++r)
-            out << "," << csv_field(d.values[r]) << (r ? "," : "");
+            out << "," << csv_field(d.values[r]) << (sampled(r) ? "," : "") << (r ? "," : "");
         out << "\n";
     }
     for (const Section& section : c.sections)
@@ -423,6 +484,7 @@ void write_csv(const Comparison& c, std::ostream& out) {
                 << csv_field(row.unit);
             for (size_t r = 0; r < n; ++r) {
                 out << "," << csv_number(row.values[r]);
+                if (sampled(r)) out << "," << csv_number(row.interval(r));
                 if (r) out << "," << csv_number(row.ratio(r));
             }
             out << "\n";
@@ -434,7 +496,8 @@ void write_csv(const Comparison& c, std::ostream& out) {
         const auto image_row = [&](const char* key, const std::string& value) {
             out << "image," << key << ",";
             for (size_t col = 0; col < n; ++col)
-                out << "," << (col == r ? value : "") << (col ? "," : "");
+                out << "," << (col == r ? value : "") << (sampled(col) ? "," : "")
+                    << (col ? "," : "");
             out << "\n";
         };
         if (!d.compared()) {
@@ -456,6 +519,7 @@ void write_json(const Comparison& c, std::ostream& out) {
     Json doc;
     doc["format"] = "tpsim-compare";
     doc["runs"] = c.runs;
+    doc["estimates"] = c.estimates;
     doc["differences"] = Json::array();
     for (const SetupDifference& d : c.differences)
         doc["differences"].push_back({{"field", d.field}, {"values", d.values}});
@@ -482,13 +546,16 @@ void write_json(const Comparison& c, std::ostream& out) {
     for (const Section& section : c.sections) {
         Json rows = Json::array();
         for (const Row& row : section.rows) {
-            Json values = Json::array(), ratios = Json::array();
+            Json values = Json::array(), ratios = Json::array(), intervals = Json::array();
             for (size_t r = 0; r < row.values.size(); ++r) {
                 values.push_back(json_number(row.values[r]));
                 ratios.push_back(json_number(row.ratio(r)));
+                intervals.push_back(json_number(row.interval(r)));  // null: unknown
             }
-            rows.push_back(
-                {{"key", row.key}, {"unit", row.unit}, {"values", values}, {"ratios", ratios}});
+            Json entry = {
+                {"key", row.key}, {"unit", row.unit}, {"values", values}, {"ratios", ratios}};
+            if (any_estimates(c)) entry["intervals"] = intervals;
+            rows.push_back(entry);
         }
         doc["sections"].push_back({{"title", section.title}, {"rows", rows}});
     }
@@ -503,6 +570,14 @@ std::optional<double> Row::ratio(size_t run) const {
     if (!first || !value) return std::nullopt;
     if (*first == 0) return *value == 0 ? std::optional<double>(1.0) : std::nullopt;
     return *value / *first;
+}
+
+bool Row::within_intervals(size_t run) const {
+    const double half = interval(0) + interval(run);
+    if (!estimated(0) && !estimated(run)) return false;
+    const auto& first = values.at(0);
+    const auto& value = values.at(run);
+    return first && value && std::isfinite(half) && std::abs(*value - *first) <= half;
 }
 
 bool Row::differs_notably(size_t run) const {
@@ -535,6 +610,8 @@ Row for_display(const Row& row) {
     shown.unit = chosen.prefix + row.unit;
     for (auto& v : shown.values)
         if (v) *v *= chosen.scale;
+    for (double& half : shown.intervals)
+        half *= chosen.scale;
     return shown;
 }
 
@@ -571,6 +648,8 @@ Comparison compare(const std::vector<StatsFile>& runs, const std::vector<std::st
     for (size_t i = 1; i < runs.size(); ++i)
         c.images.push_back(image_difference(runs[0], runs[i]));
     c.host = stat_row(runs, "host/run_seconds", Better::neutral);
+    for (const StatsFile& run : runs)
+        c.estimates.push_back(estimates_note(run));
     return c;
 }
 

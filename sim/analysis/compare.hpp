@@ -20,6 +20,16 @@ struct Row {
     std::string unit;
     Better better = Better::neutral;
     std::vector<std::optional<double>> values;  ///< one per run; absent where a run lacks it
+    /// One per run (or none: all exact): the half-width of a sampled run's confidence interval
+    /// around its estimate; 0 for an exact value; NaN for an estimate whose interval is unknown.
+    std::vector<double> intervals;
+
+    double interval(size_t run) const { return intervals.empty() ? 0.0 : intervals.at(run); }
+    /// Is values[run] an estimate (of a sampled run) rather than a count?
+    bool estimated(size_t run) const { return interval(run) != 0; }
+    /// True when run's value and the first run's differ by less than their intervals together:
+    /// the estimates cannot tell them apart (never for two exact values).
+    bool within_intervals(size_t run) const;
 
     /// values[run] / values[0]; 1 when both are 0; absent when either is absent, or only the
     /// first is 0.
@@ -51,6 +61,9 @@ struct Comparison {
     /// images[i - 1]: run i's image against run 0's; absent when neither names an image.
     std::vector<std::optional<ImageDifference>> images;
     Row host;  ///< host wall time of the kernel run: shown apart, never as a result
+    /// One per run: empty for a run of measured figures; for a sampled run, what its estimates
+    /// are ("estimates at 95 % confidence from 45 units ...").
+    std::vector<std::string> estimates;
 };
 
 /// `keys`, when not empty, keeps only the rows whose key matches one of these shell patterns

@@ -626,7 +626,8 @@ std::string ratio_cell(const Row& row, size_t r) {
         cls = row.better == Better::neutral                    ? " changed"
               : (*ratio > 1) == (row.better == Better::higher) ? " better"
                                                                : " worse";
-    return fmt::format("<td class=\"num{}\">{:.3f}x</td>", cls, *ratio);
+    return fmt::format("<td class=\"num{}\">{:.3f}x{}</td>", cls, *ratio,
+                       row.within_intervals(r) ? "~" : "");
 }
 
 }  // namespace
@@ -692,7 +693,14 @@ std::string comparison_page(const std::vector<StatsFile>& runs, const Comparison
                                  "</tr>\n",
                                  run_letter(r), escape(c.runs[r]),
                                  escape(runs[r].run_text("scene")), run_line(runs[r]));
-    page.body << "</table>\n<h2>What differs</h2>\n";
+    page.body << "</table>\n";
+    for (size_t r = 0; r < runs.size(); ++r)
+        if (!c.estimates[r].empty())
+            page.body << "<p class=\"warning\">Run " << run_letter(r) << " is "
+                      << escape(c.estimates[r])
+                      << ". A ratio marked ~ is within the intervals: the "
+                      << "estimates cannot tell the two values apart.</p>\n";
+    page.body << "<h2>What differs</h2>\n";
     if (c.differences.empty())
         page.body << "<p class=\"note\">Nothing in the run fields or the configuration.</p>\n";
     else {
@@ -772,7 +780,12 @@ std::string comparison_page(const std::vector<StatsFile>& runs, const Comparison
                       << escape(row.unit) << "</td>";
             for (size_t r = 0; r < runs.size(); ++r) {
                 page.body << "<td class=\"num\">"
-                          << (row.values[r] ? readable(*row.values[r]) : "-") << "</td>";
+                          << (row.values[r] ? readable(*row.values[r]) : "-");
+                if (row.values[r] && row.estimated(r))
+                    page.body << " <span class=\"interval\">±"
+                              << (std::isnan(row.interval(r)) ? "?" : readable(row.interval(r)))
+                              << "</span>";
+                page.body << "</td>";
                 if (r) page.body << ratio_cell(row, r);
             }
             page.body << "</tr>\n";
@@ -1261,7 +1274,8 @@ std::string sweep_page(const Json& doc, const std::string& chart_js) {
     // the header names the prefixed unit (the column's name says the SI one).
     std::vector<Row> shown;
     for (size_t c = 0; c < columns.size(); ++c) {
-        Row column{columns[c].value("name", ""), columns[c].value("unit", ""), Better::neutral, {}};
+        Row column{
+            columns[c].value("name", ""), columns[c].value("unit", ""), Better::neutral, {}, {}};
         for (const Json& row : rows) {
             const Json& value = row["stats"][c];
             column.values.push_back(value.is_number() ? std::optional(value.get<double>())

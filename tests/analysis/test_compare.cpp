@@ -1,6 +1,7 @@
 // tpsim compare: ratios, the differing setup, every output format, and image differences.
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -89,13 +90,13 @@ StatsFile run_with_image(const std::filesystem::path& directory, const std::stri
 }  // namespace
 
 TEST_CASE("compare: a ratio is the value over the first run's", "[analysis]") {
-    const Row row{"k", "", Better::lower, {4.0, 3.0, std::nullopt, 4.1}};
+    const Row row{"k", "", Better::lower, {4.0, 3.0, std::nullopt, 4.1}, {}};
     CHECK(row.ratio(0) == 1.0);
     CHECK(row.ratio(1) == 0.75);
     CHECK_FALSE(row.ratio(2));
     CHECK(row.differs_notably(1));
     CHECK_FALSE(row.differs_notably(3));  // 1.025: inside 0.95 .. 1.05
-    const Row zero{"z", "", Better::lower, {0.0, 0.0, 2.0}};
+    const Row zero{"z", "", Better::lower, {0.0, 0.0, 2.0}, {}};
     CHECK(zero.ratio(1) == 1.0);  // both zero: the same
     CHECK_FALSE(zero.ratio(2));   // undefined against zero
 }
@@ -338,4 +339,50 @@ TEST_CASE("compare: images are compared pixel by pixel", "[analysis]") {
     CHECK(doc["images"][0]["differing_pixels"] == 2);
     CHECK(doc["images"][1]["note"].get<std::string>().ends_with("does not exist"));
     std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("compare: a sampled run's figures are shown as estimates with their intervals",
+          "[analysis]") {
+    std::vector<StatsFile> runs = load({"base.json"});
+    std::ifstream in(kFixtures / "faster.json");
+    Json sampled = Json::parse(in);
+    sampled["run"]["timing"] = "sampled";
+    sampled["sampling"] = {{"estimated", true},   {"confidence", 0.95},    {"units", 12},
+                           {"trusted_units", 30}, {"too_few_units", true}, {"rate", 0.02}};
+    // chip/cycles 480000 ± 50000 against 520000: within; the hit rate's interval is unknown.
+    sampled["intervals"] = {
+        {"chip/cycles", 50000}, {"chip/l1/hit_rate", nullptr}, {"chip/l1/hits", nullptr}};
+    runs.push_back(parse_stats_file(sampled.dump(), kFixtures / "sampled.json"));
+    const Comparison c = compare(runs);
+    REQUIRE(c.estimates.size() == 2);
+    CHECK(c.estimates[0].empty());
+    CHECK(c.estimates[1].starts_with("sampled (--timing sampled): its cycle-level figures are "
+                                     "estimates, ± the half-width of their 95 % confidence "
+                                     "interval, from 12 units at rate 0.02; fewer than 30 units"));
+    const Row& cycles = c.sections[0].rows[0];
+    REQUIRE(cycles.key == "chip/cycles");
+    CHECK(cycles.estimated(1));
+    CHECK_FALSE(cycles.estimated(0));
+    CHECK(cycles.within_intervals(1));  // 40000 apart, within 50000
+    std::ostringstream text;
+    write_comparison(c, Format::text, text);
+    CHECK(text.str().find("estimates B  sampled (--timing sampled)") != std::string::npos);
+    CHECK(text.str().find("480000 ±50000   0.923x~") != std::string::npos);
+    CHECK(text.str().find(" ±?") != std::string::npos);  // the hit rate
+    CHECK(text.str().find("~ after a ratio: the two values differ by less than") !=
+          std::string::npos);
+    // A measured difference is not marked: the DRAM bytes read are exact in both.
+    CHECK(text.str().find("0.812x~") == std::string::npos);
+    CHECK(text.str().find("0.812x") != std::string::npos);
+    std::ostringstream json;
+    write_comparison(c, Format::json, json);
+    const Json doc = Json::parse(json.str());
+    CHECK(doc["estimates"][1].get<std::string>().starts_with("sampled"));
+    CHECK(doc["sections"][0]["rows"][0]["intervals"] == Json::array({0.0, 50000.0}));
+    // Two measured runs: no estimates anywhere.
+    const Comparison exact = compare(load({"base.json", "faster.json"}));
+    std::ostringstream plain;
+    write_comparison(exact, Format::text, plain);
+    CHECK(plain.str().find("±") == std::string::npos);
+    CHECK(plain.str().find("estimates") == std::string::npos);
 }

@@ -89,8 +89,17 @@ TEST_CASE("report: the comparison page has grouped charts and the side-by-side t
     REQUIRE(charts.size() == 7);
     CHECK(charts[4]["title"] == "Energy by part (J)");
     CHECK(charts[5]["title"] == "Area by part (mm²)");
-    for (const Json& chart : charts)
-        CHECK(chart["datasets"].size() == 3);  // one per run
+    // One dataset per run; the summary and per-ray charts show B's and C's change against A,
+    // in per cent: the base line of their bars is A.
+    for (const Json& chart : charts) {
+        const bool relative = chart["unit"] == "change against A";
+        CHECK(chart["datasets"].size() == (relative ? 2 : 3));
+    }
+    CHECK(charts[0]["title"] == "Summary: change against A");
+    CHECK(charts[0]["datasets"][0]["label"] == "B");
+    CHECK(charts[0]["percent"] == true);
+    // base: 520000 cycles, faster: 480000, -7.69 %
+    CHECK(std::abs(charts[0]["datasets"][0]["data"][0].get<double>() - (-100.0 * 40 / 520)) < 1e-9);
     CHECK(count(page, "<img ") == 3);
     CHECK(page.find("config l1.size_bytes") != std::string::npos);
     CHECK(page.find("C against A: RMSE") != std::string::npos);
