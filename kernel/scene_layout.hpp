@@ -14,7 +14,7 @@ namespace trax::layout {
 /// "TPSC" little-endian: lets the loader and the twin reject a memory image that is not a scene.
 constexpr uint32_t kMagic = 0x4353'5054u;
 /// Bumped whenever a struct below changes shape.
-constexpr uint32_t kVersion = 4;
+constexpr uint32_t kVersion = 5;
 
 /// Sections start on 16-word (64-byte, one cache line) boundaries so no record of one section
 /// shares a line with another section.
@@ -23,6 +23,9 @@ constexpr int32_t kSectionAlignWords = 16;
 /// Name of the marker symbol a kernel's ELF defines (TRAX_USES_BVH in trax.hpp) when it
 /// traverses the BVH: the host builds a BVH and lays it out only for such kernels.
 constexpr const char* kUsesBvhSymbol = "trax_uses_bvh";
+/// The same for a kernel that traverses the uniform grid (TRAX_USES_GRID): the host then builds
+/// the grid (and no BVH) and puts its AccelRecord, cells and references in the memory image.
+constexpr const char* kUsesGridSymbol = "trax_uses_grid";
 /// Name of the marker symbol trax.hpp's emitter and random-number functions leave in a kernel's
 /// ELF: the host adds the SceneExtras sections only for such kernels, so the memory image (and
 /// every statistic) of a kernel that reads neither stays as it was before they existed.
@@ -112,6 +115,30 @@ constexpr int32_t kMaxLeafTriangles = 8;
 /// overflows: the host builds with scene::BvhConfig::traversal_stack_entries set to it.
 constexpr int32_t kTraversalStackEntries = 32;
 
+/// Which acceleration structure an AccelRecord describes.
+enum AccelKind : int32_t {
+    kAccelGrid = 1,
+};
+
+/// The acceleration structure other than the binary BVH (which has its own header section),
+/// one record the header's `accel` word points to.
+///
+/// Uniform grid (kAccelGrid): the box [bounds_min, bounds_max] cut into resolution[0] x
+/// resolution[1] x resolution[2] cells; the cell of point p on axis a is
+/// floor((p[a] - bounds_min[a]) * scale[a]), scale = resolution / extent, and cell (x, y, z) is
+/// number x + resolution[0] * (y + resolution[1] * z). `nodes` holds one word per cell plus one:
+/// cell i's triangles are refs[nodes[i] .. nodes[i + 1]), image triangle indices, every triangle
+/// listed in every cell its bounding box overlaps (so a triangle may appear in many cells).
+struct AccelRecord {
+    int32_t kind;  ///< AccelKind
+    SectionRef nodes;
+    SectionRef refs;
+    float bounds_min[3];
+    float bounds_max[3];
+    float scale[3];
+    int32_t resolution[3];
+};
+
 /// The first words of global memory.
 struct SceneHeader {
     uint32_t magic;
@@ -133,6 +160,7 @@ struct SceneHeader {
     SectionRef thread_stats;  ///< one ThreadStats per hardware thread, written by the kernel
     SectionRef rays;          ///< ray_query input batch (count 0 for renders)
     SectionRef ray_results;   ///< ray_query output, one RayResult per ray
+    int32_t accel;            ///< word address of the AccelRecord, 0 when the image has none
 };
 
 /// Traversal statistics of one hardware thread. The kernel counts in registers and writes its
@@ -196,6 +224,7 @@ constexpr int32_t kThreadStatsWords = sizeof(ThreadStats) / 4;
 constexpr int32_t kRayWords = sizeof(Ray) / 4;
 constexpr int32_t kRayResultWords = sizeof(RayResult) / 4;
 constexpr int32_t kHeaderWords = sizeof(SceneHeader) / 4;
+constexpr int32_t kAccelRecordWords = sizeof(AccelRecord) / 4;
 
 /// Word offsets of header fields, for loadi(0, kHeader...) in kernels.
 enum HeaderWord : int32_t {
@@ -217,6 +246,7 @@ enum HeaderWord : int32_t {
     kHeaderThreadStats = 25,
     kHeaderRays = 27,
     kHeaderRayResults = 29,
+    kHeaderAccel = 31,
 };
 
 /// Word offsets of record fields, for loadf(record_addr, kTri...) in kernels.
@@ -244,6 +274,13 @@ enum RecordWord : int32_t {
     kNodeMax = 3,
     kNodeFirst = 6,
     kNodeCount = 7,
+    kAccelKind = 0,
+    kAccelNodes = 1,  ///< SectionRef: +0 addr, +1 count
+    kAccelRefs = 3,
+    kAccelBoundsMin = 5,
+    kAccelBoundsMax = 8,
+    kAccelScale = 11,
+    kAccelResolution = 14,
     kStatsPrimaryRays = 0,
     kStatsShadowRays = 1,
     kStatsNodesVisited = 2,
@@ -286,6 +323,14 @@ TRAX_LAYOUT_WORD(SceneHeader, framebuffer, kHeaderFramebuffer);
 TRAX_LAYOUT_WORD(SceneHeader, thread_stats, kHeaderThreadStats);
 TRAX_LAYOUT_WORD(SceneHeader, rays, kHeaderRays);
 TRAX_LAYOUT_WORD(SceneHeader, ray_results, kHeaderRayResults);
+TRAX_LAYOUT_WORD(SceneHeader, accel, kHeaderAccel);
+TRAX_LAYOUT_WORD(AccelRecord, kind, kAccelKind);
+TRAX_LAYOUT_WORD(AccelRecord, nodes, kAccelNodes);
+TRAX_LAYOUT_WORD(AccelRecord, refs, kAccelRefs);
+TRAX_LAYOUT_WORD(AccelRecord, bounds_min, kAccelBoundsMin);
+TRAX_LAYOUT_WORD(AccelRecord, bounds_max, kAccelBoundsMax);
+TRAX_LAYOUT_WORD(AccelRecord, scale, kAccelScale);
+TRAX_LAYOUT_WORD(AccelRecord, resolution, kAccelResolution);
 TRAX_LAYOUT_WORD(ThreadStats, primary_rays, kStatsPrimaryRays);
 TRAX_LAYOUT_WORD(ThreadStats, shadow_rays, kStatsShadowRays);
 TRAX_LAYOUT_WORD(ThreadStats, nodes_visited_lo, kStatsNodesVisited);
@@ -338,7 +383,10 @@ static_assert(sizeof(Material) == 12);
 static_assert(sizeof(Emission) == 12 && sizeof(Emitter) == 16 && sizeof(SceneExtras) == 20);
 static_assert(sizeof(Triangle) == 40);
 static_assert(sizeof(BvhNode) == 32, "the BVH node is one half cache line");
-static_assert(sizeof(SceneHeader) == 124);
+/// 32 words: one cache line pair, and the sections still start at word 32 as they did when the
+/// header was 31 words.
+static_assert(sizeof(SceneHeader) == 128);
+static_assert(sizeof(AccelRecord) == 68);
 static_assert(sizeof(ThreadStats) == 32 && sizeof(Ray) == 44 && sizeof(RayResult) == 32);
 
 /// Rounds a word address up to the section alignment.
@@ -351,22 +399,26 @@ constexpr int32_t kExtrasAddr = align_section(kHeaderWords);
 
 /// THE section placement rule. Given a header whose counts (and image size) are filled in,
 /// assigns every section's addr and total_words: sections follow the header in the order
-/// [extras], camera, lights, materials, [emission], triangles, [emitters], bvh_nodes,
-/// framebuffer, thread_stats, rays, ray_results, each aligned to kSectionAlignWords; empty
-/// sections take no space. The bracketed ones exist only with `extras` (its emitters count
-/// filled in; the emission count is set to the materials count); without it the image is laid
-/// out as if they did not exist. The framebuffer count is set from the image size, the
-/// ray_results count from the rays count. The scene compiler calls this; tests check images
-/// against it.
-constexpr void place_sections(SceneHeader& h, SceneExtras* extras = nullptr) {
+/// [extras], camera, lights, materials, [emission], triangles, [emitters], bvh_nodes, [accel,
+/// accel nodes, accel refs], framebuffer, thread_stats, rays, ray_results, each aligned to
+/// kSectionAlignWords; empty sections take no space. The bracketed ones exist only with `extras`
+/// (its emitters count filled in; the emission count is set to the materials count) or `accel`
+/// (its nodes and refs counts filled in, one word per entry; h.accel is set to the record's
+/// address); without them the image is laid out as if they did not exist. The framebuffer count
+/// is set from the image size, the ray_results count from the rays count. The scene compiler
+/// calls this; tests check images against it.
+constexpr void place_sections(SceneHeader& h, SceneExtras* extras = nullptr,
+                              AccelRecord* accel = nullptr) {
     h.camera.count = 1;
     h.framebuffer.count = h.image_width * h.image_height;
     h.ray_results.count = h.rays.count;
     SectionRef extras_record{0, 0}, no_emission{0, 0}, no_emitters{0, 0};
+    SectionRef accel_record{0, 0}, no_accel_nodes{0, 0}, no_accel_refs{0, 0};
     if (extras != nullptr) {
         extras_record.count = 1;
         extras->emission.count = h.materials.count;
     }
+    if (accel != nullptr) accel_record.count = 1;
     struct Section {
         SectionRef* ref;
         int32_t record_words;
@@ -380,6 +432,9 @@ constexpr void place_sections(SceneHeader& h, SceneExtras* extras = nullptr) {
         {&h.triangles, kTriangleWords},
         {extras ? &extras->emitters : &no_emitters, kEmitterWords},
         {&h.bvh_nodes, kBvhNodeWords},
+        {&accel_record, kAccelRecordWords},
+        {accel ? &accel->nodes : &no_accel_nodes, 1},
+        {accel ? &accel->refs : &no_accel_refs, 1},
         {&h.framebuffer, kPixelWords},
         {&h.thread_stats, kThreadStatsWords},
         {&h.rays, kRayWords},
@@ -390,6 +445,7 @@ constexpr void place_sections(SceneHeader& h, SceneExtras* extras = nullptr) {
         s.ref->addr = next;
         if (s.ref->count > 0) next = align_section(next + s.ref->count * s.record_words);
     }
+    h.accel = accel != nullptr ? accel_record.addr : 0;
     h.total_words = next;
 }
 

@@ -111,6 +111,13 @@ TRAX_CSR_FUNCTION(trax_tm_size, 0xCC4)
         ".globl trax_uses_bvh\n.type trax_uses_bvh, @function\n"                                   \
         "trax_uses_bvh:\n  ret\n.size trax_uses_bvh, . - trax_uses_bvh\n.popsection")
 
+/// Write `TRAX_USES_GRID;` at file scope in a kernel that traverses the uniform grid (kernel/
+/// grid.hpp): tpsim then builds the grid instead of a BVH (trax::layout::kUsesGridSymbol).
+#define TRAX_USES_GRID                                                                             \
+    asm(".pushsection .text.trax_uses_grid, \"ax\", @progbits\n"                                   \
+        ".globl trax_uses_grid\n.type trax_uses_grid, @function\n"                                 \
+        "trax_uses_grid:\n  ret\n.size trax_uses_grid, . - trax_uses_grid\n.popsection")
+
 namespace trax::detail {
 /// Leaves the marker trax::layout::kUsesExtrasSymbol in the ELF (once per object file: .ifndef;
 /// weak, so objects may share it; kept by the link script). Called by every function that reads
@@ -141,8 +148,9 @@ TRAX_INLINE void set_rand_state(uint32_t state) {
 #include <string>
 
 #define TRAX_INLINE inline
-/// The twin is told about the BVH by the host, which reads the marker from the ELF.
+/// The twin is told about the BVH or grid by the host, which reads the marker from the ELF.
 #define TRAX_USES_BVH static_assert(true)
+#define TRAX_USES_GRID static_assert(true)
 
 namespace trax::native {
 

@@ -178,7 +178,17 @@ std::string run_line(const StatsFile& run) {
         parts.push_back(fmt::format("{}x{} pixels", field("width"), field("height")));
     if (!field("samples_per_pixel").empty()) parts.push_back(field("samples_per_pixel") + " spp");
     if (!field("threads").empty()) parts.push_back(field("threads") + " threads");
-    if (!field("bvh_builder").empty())
+    // The structure the kernel traversed (files without `accel` come from BVH-only tpsim).
+    const std::string accel = field("accel");
+    if (accel == "grid")
+        parts.push_back(
+            field("grid_resolution") == "0"
+                ? fmt::format("uniform grid, {} cells per triangle", field("grid_density"))
+                : fmt::format("uniform grid, {} cells on the longest axis",
+                              field("grid_resolution")));
+    else if (accel == "none")
+        parts.push_back("no acceleration structure");
+    else if (!field("bvh_builder").empty())
         parts.push_back(
             fmt::format("BVH {}, max_leaf {}", field("bvh_builder"), field("max_leaf")));
     std::string line;

@@ -32,7 +32,10 @@ struct RenderCommandOptions {
     std::string scene;
     std::string up;
     std::string output;
-    std::string kernel = "tracer";
+    std::string kernel;  // "": the tracer of --accel
+    std::string accel;
+    uint32_t grid_resolution = 0;
+    double grid_density = scene::GridConfig{}.density;
     std::vector<std::string> params;
     std::string config;
     std::vector<std::string> overrides;
@@ -73,7 +76,14 @@ int run_render(RenderCommandOptions& o) {
     options.on_warning = [](const std::string& warning) {
         fmt::print(stderr, "tpsim: warning: {}\n", warning);
     };
-    options.kernel = resolve_kernel(o.kernel);
+    if (!o.accel.empty()) options.accel = scene::find_accel(o.accel)->structure;
+    options.kernel = resolve_kernel(
+        !o.kernel.empty()
+            ? o.kernel
+            : std::string(scene::accel_info(options.accel.value_or(scene::AccelStructure::bvh2))
+                              .default_kernel));
+    options.grid.resolution = o.grid_resolution;
+    options.grid.density = o.grid_density;
     options.params = o.params;
     options.engine = o.native             ? render::Engine::native
                      : o.timing != "none" ? render::Engine::timing
@@ -208,7 +218,25 @@ Command add_render_command(CLI::App& app) {
     command->add_option(
         "-o,--output", o->output,
         "Image to write (.png 8-bit sRGB; .exr/.tif linear float) [default: SCENE.png]");
-    command->add_option("-k,--kernel", o->kernel, "Built kernel name, or a path to a kernel ELF")
+    command->add_option("-k,--kernel", o->kernel,
+                        "Built kernel name, or a path to a kernel ELF [default: tracer, or the "
+                        "tracer of --accel]");
+    command
+        ->add_option("--accel", o->accel,
+                     "Acceleration structure: bvh2 (binary BVH, kernel tracer) or grid (uniform "
+                     "grid, kernel tracer_grid); with --kernel, the one the kernel traverses "
+                     "(docs/accel.md) [default: the kernel's]")
+        ->check(CLI::IsMember({"bvh2", "grid"}));
+    command
+        ->add_option("--grid-resolution", o->grid_resolution,
+                     "Uniform grid: cells along the scene's longest axis, the others in "
+                     "proportion; 0: by --grid-density")
+        ->check(whole_number_in(0, scene::kGridMaxResolution))
+        ->capture_default_str();
+    command
+        ->add_option("--grid-density", o->grid_density,
+                     "Uniform grid: cells per triangle (cubic cells) when --grid-resolution is 0")
+        ->check(CLI::Range(1.0 / 1024, scene::kGridMaxDensity))
         ->capture_default_str();
     command
         ->add_option("-p,--param", o->params,

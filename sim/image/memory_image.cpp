@@ -102,12 +102,14 @@ std::vector<layout::Emitter> compile_emitters(const std::vector<layout::Triangle
 
 }  // namespace
 
-MemoryImage build_memory_image(const scene::Scene& scene, const scene::Bvh* bvh, uint32_t threads,
+MemoryImage build_memory_image(const scene::Scene& scene, Accel accel, uint32_t threads,
                                std::span<const layout::Ray> rays,
                                std::optional<uint32_t> extras_seed) {
     if (scene.width == 0 || scene.height == 0)
         throw Error("scene has an empty image (width or height is 0)");
     if (scene.triangles.empty()) throw Error("scene has no triangles");
+    const scene::Bvh* bvh = accel.bvh;
+    const scene::Grid* grid = accel.grid;
 
     layout::SceneHeader h{};
     h.magic = layout::kMagic;
@@ -137,6 +139,17 @@ MemoryImage build_memory_image(const scene::Scene& scene, const scene::Bvh* bvh,
     h.bvh_nodes.count = checked_count(nodes.size(), "BVH nodes");
     h.thread_stats.count = checked_count(threads, "threads");
     h.rays.count = checked_count(rays.size(), "rays");
+    layout::AccelRecord accel_record{};
+    if (grid != nullptr) {
+        accel_record.kind = layout::kAccelGrid;
+        accel_record.nodes.count = checked_count(grid->cell_start.size(), "grid cells");
+        accel_record.refs.count = checked_count(grid->references.size(), "grid references");
+        put(accel_record.bounds_min, grid->lo);
+        put(accel_record.bounds_max, grid->hi);
+        put(accel_record.scale, grid->scale);
+        for (int a = 0; a < 3; ++a)
+            accel_record.resolution[a] = int32_t(grid->stats.resolution[size_t(a)]);
+    }
     const uint64_t pixels = uint64_t(scene.width) * scene.height;
     if (pixels > uint64_t(std::numeric_limits<int32_t>::max() / 16))
         throw Error(fmt::format("image {}x{} is too large for the 32-bit memory image", scene.width,
@@ -144,6 +157,7 @@ MemoryImage build_memory_image(const scene::Scene& scene, const scene::Bvh* bvh,
     const uint64_t estimate =
         uint64_t(h.triangles.count) * layout::kTriangleWords +
         uint64_t(h.bvh_nodes.count) * layout::kBvhNodeWords + pixels * layout::kPixelWords +
+        uint64_t(accel_record.nodes.count) + uint64_t(accel_record.refs.count) +
         uint64_t(threads) * layout::kThreadStatsWords +
         uint64_t(rays.size()) * (layout::kRayWords + layout::kRayResultWords) +
         (extras_seed ? uint64_t(h.triangles.count) * layout::kEmitterWords +
@@ -179,7 +193,7 @@ MemoryImage build_memory_image(const scene::Scene& scene, const scene::Bvh* bvh,
         emitters = compile_emitters(triangles, scene.materials);
         extras.emitters.count = checked_count(emitters.size(), "emitters");
     }
-    layout::place_sections(h, extras_seed ? &extras : nullptr);
+    layout::place_sections(h, extras_seed ? &extras : nullptr, grid ? &accel_record : nullptr);
 
     MemoryImage image;
     image.words.assign(size_t(h.total_words), 0u);
@@ -212,6 +226,13 @@ MemoryImage build_memory_image(const scene::Scene& scene, const scene::Bvh* bvh,
         write(image.words, h.triangles.addr + int32_t(i) * layout::kTriangleWords, triangles[i]);
     for (size_t i = 0; i < nodes.size(); ++i)
         write(image.words, h.bvh_nodes.addr + int32_t(i) * layout::kBvhNodeWords, nodes[i]);
+    if (grid != nullptr) {
+        write(image.words, h.accel, accel_record);
+        std::memcpy(image.words.data() + accel_record.nodes.addr, grid->cell_start.data(),
+                    grid->cell_start.size() * 4);
+        std::memcpy(image.words.data() + accel_record.refs.addr, grid->references.data(),
+                    grid->references.size() * 4);
+    }
     for (size_t i = 0; i < rays.size(); ++i)
         write(image.words, h.rays.addr + int32_t(i) * layout::kRayWords, rays[i]);
 
@@ -234,6 +255,12 @@ MemoryImage build_memory_image(const scene::Scene& scene, const scene::Bvh* bvh,
     if (extras_seed)
         image.sections.push_back(section("emitters", extras.emitters, layout::kEmitterWords));
     image.sections.push_back(section("bvh_nodes", h.bvh_nodes, layout::kBvhNodeWords));
+    // The structure's sections only when it is there, named after it.
+    if (grid != nullptr) {
+        image.sections.push_back({"grid", 1, sizeof(accel_record), uint64_t(h.accel) * 4});
+        image.sections.push_back(section("grid_cells", accel_record.nodes, 1));
+        image.sections.push_back(section("grid_refs", accel_record.refs, 1));
+    }
     image.sections.push_back(section("framebuffer", h.framebuffer, layout::kPixelWords));
     image.sections.push_back(section("thread_stats", h.thread_stats, layout::kThreadStatsWords));
     image.sections.push_back(section("rays", h.rays, layout::kRayWords));

@@ -9,6 +9,7 @@
 
 #include "kernel/scene_layout.hpp"
 #include "sim/scene/bvh.hpp"
+#include "sim/scene/grid.hpp"
 #include "sim/scene/scene.hpp"
 
 namespace tpsim::image {
@@ -34,14 +35,26 @@ struct MemoryImage {
     uint64_t read_only_bytes() const { return uint64_t(header.framebuffer.addr) * 4; }
 };
 
+/// The acceleration structure to lay out with the scene: at most one, the one the kernel
+/// traverses (or none, for brute force).
+struct Accel {
+    const scene::Bvh* bvh = nullptr;
+    const scene::Grid* grid = nullptr;
+    Accel(std::nullptr_t = nullptr) {}
+    Accel(const scene::Bvh* b) : bvh(b) {}
+    Accel(const scene::Grid* g) : grid(g) {}
+};
+
 /// Lays the scene out. With a BVH, triangles are stored in leaf order and nodes with sibling
 /// pairs adjacent, as the traversal kernel expects; without one, the BVH section is left out.
+/// With a grid, the AccelRecord and the grid's cells and references (sections "grid",
+/// "grid_cells", "grid_refs"), triangles in scene order.
 /// One zeroed ThreadStats record per thread (`threads` of them); `rays` (for the ray_query
 /// kernel) and room for as many RayResults. With `extras_seed`, also the SceneExtras record
 /// (that run seed, every material's emission, the emissive triangles): only for kernels that
 /// read it (their ELF defines trax::layout::kUsesExtrasSymbol). Throws tpsim::Error if the
 /// scene does not fit the layout (e.g. more than 2^31 words).
-MemoryImage build_memory_image(const scene::Scene& scene, const scene::Bvh* bvh, uint32_t threads,
+MemoryImage build_memory_image(const scene::Scene& scene, Accel accel, uint32_t threads,
                                std::span<const trax::layout::Ray> rays = {},
                                std::optional<uint32_t> extras_seed = std::nullopt);
 

@@ -86,8 +86,17 @@ std::string Kernel::stale_warning() const {
     return "";
 }
 
-bool Kernel::uses_bvh() const {
-    return defines(trax::layout::kUsesBvhSymbol);
+scene::AccelStructure Kernel::accel() const {
+    const bool bvh = defines(trax::layout::kUsesBvhSymbol);
+    const bool grid = defines(trax::layout::kUsesGridSymbol);
+    if (bvh && grid)
+        throw Error(fmt::format("kernel '{}' declares both TRAX_USES_BVH and TRAX_USES_GRID; a "
+                                "kernel traverses one structure: keep the marker of the one it "
+                                "reads",
+                                elf.filename().string()));
+    return bvh    ? scene::AccelStructure::bvh2
+           : grid ? scene::AccelStructure::grid
+                  : scene::AccelStructure::none;
 }
 
 bool Kernel::uses_extras() const {
@@ -160,19 +169,38 @@ RenderResult render(const RenderOptions& options) {
     if (const std::string warning = check_stack(kernel, options.engine, options.chip);
         !warning.empty() && options.on_warning)
         options.on_warning(warning);
+    result.accel = kernel.accel();
+    if (options.accel && *options.accel != result.accel)
+        throw Error(fmt::format(
+            "--accel {} asks for {} but kernel '{}' traverses {}; give a kernel that traverses "
+            "it (e.g. --kernel {}) or leave --accel out",
+            scene::to_string(*options.accel), scene::accel_info(*options.accel).description,
+            kernel.elf.filename().string(), scene::accel_info(result.accel).description,
+            scene::accel_info(*options.accel).default_kernel));
     std::optional<scene::Bvh> bvh;
-    if (kernel.uses_bvh()) {
+    std::optional<scene::Grid> grid;
+    if (result.accel == scene::AccelStructure::bvh2) {
         start = std::chrono::steady_clock::now();
         scene::BvhConfig config = options.bvh;
         config.traversal_stack_entries = trax::layout::kTraversalStackEntries;
         bvh = scene::build_bvh(result.scene.triangles, config);
         result.bvh_seconds = seconds_since(start);
         result.bvh = bvh->stats;
+    } else if (result.accel == scene::AccelStructure::grid) {
+        start = std::chrono::steady_clock::now();
+        try {
+            grid = scene::build_grid(result.scene.triangles, options.grid);
+        } catch (const std::invalid_argument& e) {
+            throw Error(e.what());
+        }
+        result.grid_seconds = seconds_since(start);
+        result.grid = grid->stats;
     }
     result.threads = options.chip.chip.num_tms * options.chip.chip.tps_per_tm;
-    result.image = image::build_memory_image(
-        result.scene, bvh ? &*bvh : nullptr, result.threads, {},
-        kernel.uses_extras() ? std::optional(options.seed) : std::nullopt);
+    const image::Accel accel = bvh ? image::Accel(&*bvh) : grid ? image::Accel(&*grid) : nullptr;
+    result.image = image::build_memory_image(result.scene, accel, result.threads, {},
+                                             kernel.uses_extras() ? std::optional(options.seed)
+                                                                  : std::nullopt);
 
     const uint64_t item_limit = options.max_item_instructions != 0
                                     ? options.max_item_instructions

@@ -18,7 +18,9 @@
 #include "sim/render/kernel_params.hpp"
 #include "sim/render/native_twin.hpp"
 #include "sim/render/sampling.hpp"
+#include "sim/scene/accel.hpp"
 #include "sim/scene/bvh.hpp"
+#include "sim/scene/grid.hpp"
 #include "sim/scene/load_scene.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/timing/config.hpp"
@@ -59,8 +61,10 @@ struct Kernel {
     /// Sets parameters from NAME=VALUE assignments (render --param) in the program and for the
     /// twin. Throws tpsim::Error for an unknown name or a bad value (set_params).
     void set_params(const std::vector<std::string>& assignments);
-    /// Does the kernel traverse a BVH (define trax::layout::kUsesBvhSymbol)?
-    bool uses_bvh() const;
+    /// The structure the kernel traverses, from the marker its ELF defines (trax::layout::
+    /// kUsesBvhSymbol, kUsesGridSymbol); none for brute force. Throws tpsim::Error for a kernel
+    /// that defines more than one.
+    scene::AccelStructure accel() const;
     /// Does the kernel read the SceneExtras record (define trax::layout::kUsesExtrasSymbol)?
     bool uses_extras() const;
     /// Does the ELF define a function (or code label) of this name?
@@ -85,6 +89,11 @@ struct RenderOptions {
     /// marker); other kernels get no BVH in their memory image. render() sets the depth limit
     /// to the kernels' stack capacity (trax::layout::kTraversalStackEntries).
     scene::BvhConfig bvh;
+    /// The grid to build when the kernel traverses one (TRAX_USES_GRID).
+    scene::GridConfig grid;
+    /// The structure the user asked for (render --accel): render() refuses a kernel that
+    /// traverses another. Unset: whichever the kernel traverses.
+    std::optional<scene::AccelStructure> accel;
     /// Override the scene file's image size and samples per pixel when non-zero
     /// (render --width/--height/--spp; tests render small images).
     uint32_t image_width = 0, image_height = 0, samples_per_pixel = 0;
@@ -122,18 +131,21 @@ struct KernelRun {
 };
 
 struct RenderResult {
-    scene::Scene scene;                  ///< as loaded (triangles included)
-    std::optional<scene::BvhStats> bvh;  ///< when a BVH was built
-    image::MemoryImage image;            ///< the memory image after the run
-    image::TraversalTotals traversal;    ///< the kernel's per-thread statistics, summed
-    std::vector<float> rgb;              ///< framebuffer, linear RGB, row 0 at the top
-    InstructionCounts instructions;      ///< zero for the native engine
-    trax::KernelOutput output;           ///< what the kernel printed (trax_printf)
-    std::vector<KernelParam> params;     ///< the kernel's parameters as the run set them
+    scene::Scene scene;                                         ///< as loaded (triangles included)
+    scene::AccelStructure accel = scene::AccelStructure::none;  ///< what the kernel traverses
+    std::optional<scene::BvhStats> bvh;                         ///< when a BVH was built
+    std::optional<scene::GridStats> grid;                       ///< when a grid was built
+    image::MemoryImage image;                                   ///< the memory image after the run
+    image::TraversalTotals traversal;  ///< the kernel's per-thread statistics, summed
+    std::vector<float> rgb;            ///< framebuffer, linear RGB, row 0 at the top
+    InstructionCounts instructions;    ///< zero for the native engine
+    trax::KernelOutput output;         ///< what the kernel printed (trax_printf)
+    std::vector<KernelParam> params;   ///< the kernel's parameters as the run set them
     uint32_t threads = 0;
     std::shared_ptr<const TimingRun> timing;  ///< Engine::timing: the chip and its counters
     std::shared_ptr<const Profile> profile;   ///< RenderOptions::profile: by function and line
-    double load_seconds = 0, bvh_seconds = 0, run_seconds = 0;  ///< host wall clock
+    /// Host wall clock: loading the scene, building the BVH or the grid, running the kernel.
+    double load_seconds = 0, bvh_seconds = 0, grid_seconds = 0, run_seconds = 0;
     /// The host threads the kernel run used: at most `host_threads`, for this share of its
     /// instructions (the rest on one; TimingRun).
     uint32_t host_threads = 1;

@@ -218,6 +218,29 @@ void register_stats(const RenderResult& r, stats::Registry& reg) {
         number(
             "host/bvh_seconds", [&r] { return r.bvh_seconds; }, "BVH build time", "s");
     }
+    if (r.grid) {
+        const scene::GridStats& g = *r.grid;
+        number(
+            "grid/cells", [&g] { return g.cells; }, "uniform grid cells", "cells");
+        for (int a = 0; a < 3; ++a)
+            number(
+                fmt::format("grid/resolution_{}", "xyz"[a]), [&g, a] { return g.resolution[a]; },
+                fmt::format("grid cells along {}", "xyz"[a]), "cells");
+        number(
+            "grid/references", [&g] { return g.references; },
+            "triangle entries over all cells (a triangle in k cells counts k)");
+        number(
+            "grid/references_per_triangle",
+            [&g, &r] { return double(g.references) / double(r.scene.triangles.size()); },
+            "cells a triangle is listed in, on average");
+        number(
+            "grid/empty_cells", [&g] { return g.empty_cells; }, "cells with no triangle", "cells");
+        number(
+            "grid/max_cell_triangles", [&g] { return g.max_cell_triangles; },
+            "most triangles listed in one cell");
+        number(
+            "host/grid_seconds", [&r] { return r.grid_seconds; }, "grid build time", "s");
+    }
 
     const image::TraversalTotals& t = r.traversal;
     const auto per_ray = [&t](uint64_t count) {
@@ -231,7 +254,7 @@ void register_stats(const RenderResult& r, stats::Registry& reg) {
         "rays/shadow", [&t] { return t.shadow_rays; }, "any-hit (shadow) rays", "rays");
     number(
         "traversal/nodes_per_ray", [&t, per_ray] { return per_ray(t.nodes_visited); },
-        "BVH node boxes tested per ray, on average", "nodes");
+        "BVH node boxes tested (grid cells walked) per ray, on average", "nodes");
     number(
         "traversal/triangles_per_ray", [&t, per_ray] { return per_ray(t.triangles_tested); },
         "ray/triangle tests per ray, on average", "triangles");
@@ -386,14 +409,27 @@ void print_summary(const RenderOptions& options, const RenderResult& r,
                    r.bvh->depth_limited_nodes
                        ? fmt::format(" (depth limit shaped {} nodes)", r.bvh->depth_limited_nodes)
                        : "");
-    if (r.traversal.rays() > 0)
+    if (r.grid) {
+        const scene::GridStats& g = *r.grid;
         fmt::print(out,
-                   "rays     {} ({} primary, {} shadow): {:.1f} nodes, {:.1f} triangles per ray, "
-                   "stack depth up to {}\n",
+                   "grid     {}x{}x{} = {} cells, {} references ({:.2f} per triangle), {:.1f} % "
+                   "empty, at most {} in a cell, built in {:.3f} s\n",
+                   g.resolution[0], g.resolution[1], g.resolution[2], g.cells, g.references,
+                   double(g.references) / double(r.scene.triangles.size()),
+                   100.0 * double(g.empty_cells) / double(g.cells), g.max_cell_triangles,
+                   r.grid_seconds);
+    }
+    if (r.traversal.rays() > 0) {
+        const double rays = double(r.traversal.rays());
+        fmt::print(out, "rays     {} ({} primary, {} shadow): {:.1f} {}, {:.1f} triangles per ray",
                    r.traversal.rays(), r.traversal.primary_rays, r.traversal.shadow_rays,
-                   double(r.traversal.nodes_visited) / double(r.traversal.rays()),
-                   double(r.traversal.triangles_tested) / double(r.traversal.rays()),
-                   r.traversal.max_stack_depth);
+                   double(r.traversal.nodes_visited) / rays, r.grid ? "cells" : "nodes",
+                   double(r.traversal.triangles_tested) / rays);
+        if (r.grid)
+            fmt::print(out, "\n");
+        else
+            fmt::print(out, ", stack depth up to {}\n", r.traversal.max_stack_depth);
+    }
     if (r.timing) {
         // From the statistics, so that a sampled run shows its estimates.
         const double cycles = statistics.values.value("chip/cycles");
@@ -464,6 +500,11 @@ nlohmann::ordered_json stats_document(const RenderOptions& options, const Render
     run["engine"] = engine_name(options.engine);
     // How the cycle-level engine ran: every cycle, or sampled (its figures are estimates).
     if (r.timing) run["timing"] = r.timing->sampling ? "sampled" : "cycle";
+    run["accel"] = scene::to_string(r.accel);
+    if (r.grid) {
+        run["grid_resolution"] = options.grid.resolution;
+        run["grid_density"] = options.grid.density;
+    }
     run["bvh_builder"] = scene::to_string(options.bvh.builder);
     run["max_leaf"] = options.bvh.max_leaf_size;
     run["width"] = r.scene.width;

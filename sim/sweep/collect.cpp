@@ -90,7 +90,8 @@ Table collect(const Sweep& sweep, const std::filesystem::path& dir,
                     keys.push_back(stat.first);
             double host = 0;
             bool any = false;
-            for (const char* key : {"host/load_seconds", "host/bvh_seconds", "host/run_seconds"})
+            for (const char* key :
+                 {"host/load_seconds", "host/bvh_seconds", "host/grid_seconds", "host/run_seconds"})
                 if (const auto seconds = run.stat(key)) {
                     host += *seconds;
                     any = true;

@@ -45,6 +45,9 @@ render::RenderOptions render_options(const JobRun& run) {
                           : run.bvh == "median" ? scene::BvhBuilder::median
                                                 : scene::BvhBuilder::sweep;
     options.bvh.max_leaf_size = run.max_leaf;
+    if (!run.accel.empty()) options.accel = scene::find_accel(run.accel)->structure;
+    options.grid.resolution = run.grid_resolution;
+    options.grid.density = run.grid_density;
     options.image_width = run.width;
     options.image_height = run.height;
     options.samples_per_pixel = run.spp;

@@ -23,7 +23,11 @@ using Json = nlohmann::ordered_json;
 struct JobRun {
     std::filesystem::path scene;
     std::filesystem::path kernel;
-    std::string bvh = "sweep";  ///< BVH builder: sweep, binned or median
+    /// The acceleration structure asked for (scene::kAccelStructures' names); "": the kernel's.
+    std::string accel;
+    uint32_t grid_resolution = 0;  ///< scene::GridConfig::resolution
+    double grid_density = 4.0;     ///< scene::GridConfig::density
+    std::string bvh = "sweep";     ///< BVH builder: sweep, binned or median
     uint32_t max_leaf = 8;
     uint32_t width = 0, height = 0, spp = 0;  ///< 0: the scene's
     uint32_t seed = 0;
@@ -69,8 +73,9 @@ struct Sweep {
 using KernelResolver = std::function<std::filesystem::path(const std::string&)>;
 
 /// The settings a sweep file may name besides chip configuration keys.
-inline constexpr const char* kRunSettings[] = {"scene", "kernel", "config", "bvh",  "max_leaf",
-                                               "width", "height", "spp",    "seed", "timing"};
+inline constexpr const char* kRunSettings[] = {
+    "scene", "kernel", "config", "accel", "grid_resolution", "grid_density", "bvh", "max_leaf",
+    "width", "height", "spp",    "seed",  "timing"};
 
 /// Reads, checks and expands a sweep file. Throws tpsim::Error with one line naming
 /// file:line for anything wrong (unknown key, bad value, missing scene, empty axis, zip groups

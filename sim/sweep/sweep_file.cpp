@@ -10,6 +10,8 @@
 #include "sim/core/error.hpp"
 #include "sim/core/input_file.hpp"
 #include "sim/core/toml_nesting.hpp"
+#include "sim/scene/accel.hpp"
+#include "sim/scene/grid.hpp"
 #include "sim/sweep/sweep.hpp"
 
 namespace tpsim::sweep {
@@ -190,6 +192,13 @@ private:
         return v.value.get<uint64_t>();
     }
 
+    double number(const std::string& name, const Value& v, double lo, double hi) const {
+        if (!v.value.is_number() || !(v.value.get<double>() >= lo && v.value.get<double>() <= hi))
+            fail(v.line, fmt::format("{} must be a number in [{}, {}], got {}", name, lo, hi,
+                                     v.value.dump()));
+        return v.value.get<double>();
+    }
+
     std::string one_of(const std::string& name, const Value& v,
                        std::initializer_list<const char*> allowed) const {
         if (v.value.is_string())
@@ -241,6 +250,12 @@ private:
             } catch (const Error& e) {
                 fail(v.line, fmt::format("config: {}", e.what()));
             }
+        } else if (name == "accel") {
+            run.accel = one_of(name, v, {"bvh2", "grid"});
+        } else if (name == "grid_resolution") {
+            run.grid_resolution = uint32_t(integer(name, v, 0, scene::kGridMaxResolution));
+        } else if (name == "grid_density") {
+            run.grid_density = number(name, v, 1.0 / 1024, scene::kGridMaxDensity);
         } else if (name == "bvh") {
             run.bvh = one_of(name, v, {"sweep", "binned", "median"});
         } else if (name == "max_leaf") {
@@ -380,7 +395,11 @@ private:
             if (s.name == "config") apply(job.run, s.name, {s.value, line_of(s.name)});
         for (const Setting& s : settings)
             if (s.name != "config") apply(job.run, s.name, {s.value, line_of(s.name)}, &chip_keys);
-        if (job.run.kernel.empty()) job.run.kernel = resolve_kernel_("tracer");
+        // No kernel: the tracer of the structure asked for.
+        if (job.run.kernel.empty())
+            job.run.kernel = resolve_kernel_(std::string(
+                job.run.accel.empty() ? "tracer"
+                                      : scene::find_accel(job.run.accel)->default_kernel));
         if (chip_keys.empty()) return;
         // All keys at once over the base, then validated together (l1.line_bytes and
         // l2.line_bytes may only change together). Each key is written on its line of the
@@ -468,6 +487,9 @@ void write_plan(const Sweep& sweep, const std::filesystem::path& dir) {
                         {"run",
                          {{"scene", r.scene.string()},
                           {"kernel", r.kernel.string()},
+                          {"accel", r.accel},
+                          {"grid_resolution", r.grid_resolution},
+                          {"grid_density", r.grid_density},
                           {"bvh", r.bvh},
                           {"max_leaf", r.max_leaf},
                           {"width", r.width},
@@ -532,6 +554,9 @@ Sweep read_plan(const std::filesystem::path& dir) {
             const Json& r = j.at("run");
             job.run.scene = r.at("scene").get<std::string>();
             job.run.kernel = r.at("kernel").get<std::string>();
+            job.run.accel = r.at("accel").get<std::string>();
+            job.run.grid_resolution = r.at("grid_resolution").get<uint32_t>();
+            job.run.grid_density = r.at("grid_density").get<double>();
             job.run.bvh = r.at("bvh").get<std::string>();
             job.run.max_leaf = r.at("max_leaf").get<uint32_t>();
             job.run.width = r.at("width").get<uint32_t>();

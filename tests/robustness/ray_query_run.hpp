@@ -1,5 +1,6 @@
-// The harness both robustness tests share: the ray_query kernel over a batch of rays, on the
-// functional simulator and on the native twin, whose results must agree bit for bit.
+// The harness both robustness tests share: a ray_query kernel (ray_query through the BVH,
+// ray_query_grid through the uniform grid) over a batch of rays, on the functional simulator
+// and on the native twin, whose results must agree bit for bit.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -21,12 +22,12 @@ struct RayQueryRun {
     image::MemoryImage image;                      ///< the functional run's memory image
 };
 
-/// Runs ray_query (TPSIM_KERNEL_DIR) over `rays` through `bvh` of `triangles` on 1 TM x 4 TPs
-/// with an instruction budget per thread (a ray that hung the traversal fails the run), on both
-/// engines; REQUIREs one result per ray and bit-identical results.
-inline RayQueryRun run_ray_query(const std::vector<scene::Triangle>& triangles,
-                                 const scene::Bvh& bvh, const std::vector<trax::layout::Ray>& rays,
-                                 uint64_t budget) {
+/// Runs the ray_query kernel of `accel` (TPSIM_KERNEL_DIR) over `rays` through that structure
+/// of `triangles` on 1 TM x 4 TPs with an instruction budget per thread (a ray that hung the
+/// traversal fails the run), on both engines; REQUIREs one result per ray and bit-identical
+/// results.
+inline RayQueryRun run_ray_query(const std::vector<scene::Triangle>& triangles, image::Accel accel,
+                                 const std::vector<trax::layout::Ray>& rays, uint64_t budget) {
     scene::Scene s;
     s.triangles = triangles;
     s.materials.resize(1);
@@ -34,14 +35,14 @@ inline RayQueryRun run_ray_query(const std::vector<scene::Triangle>& triangles,
     timing::ChipConfig chip;
     chip.chip.num_tms = 1;
     chip.chip.tps_per_tm = 4;
-    const auto kernel =
-        render::Kernel::load(std::filesystem::path(TPSIM_KERNEL_DIR) / "ray_query.elf");
+    const auto kernel = render::Kernel::load(std::filesystem::path(TPSIM_KERNEL_DIR) /
+                                             (accel.grid ? "ray_query_grid.elf" : "ray_query.elf"));
 
     RayQueryRun run;
     std::vector<trax::layout::RayResult> per_engine[2];
     const render::Engine engines[2] = {render::Engine::functional, render::Engine::native};
     for (int e = 0; e < 2; ++e) {
-        image::MemoryImage img = image::build_memory_image(s, &bvh, 4, rays);
+        image::MemoryImage img = image::build_memory_image(s, accel, 4, rays);
         render::run_kernel(kernel, engines[e], img, chip, budget);
         per_engine[e] = image::read_ray_results(img.header, img.words.data());
         run.totals[e] = image::read_thread_stats(img.header, img.words.data());

@@ -1,6 +1,7 @@
-// Stiff and extreme ray-tracing cases (docs/robustness.md), traced by the ray_query kernel
-// through the tracer's BVH traversal, on the functional simulator AND the native twin: every
-// result must agree bit for bit between the two, and meet the geometric expectation.
+// Stiff and extreme ray-tracing cases (docs/robustness.md), traced by the ray_query kernels
+// through the tracer's BVH traversal and through the uniform grid, on the functional simulator
+// AND the native twin: every result must agree bit for bit between the two, and meet the
+// geometric expectation, for either structure.
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -12,7 +13,9 @@
 
 #include "sim/image/memory_image.hpp"
 #include "sim/render/render.hpp"
+#include "sim/scene/accel.hpp"
 #include "sim/scene/bvh.hpp"
+#include "sim/scene/grid.hpp"
 #include "tests/robustness/ray_query_run.hpp"
 
 using namespace tpsim;
@@ -113,11 +116,28 @@ Ray make_ray(glm::vec3 origin, glm::vec3 dir, float t_max, int mode = trax::layo
                {target.x, target.y, target.z}};
 }
 
+using scene::AccelStructure;
+
+/// Each test runs once per structure.
+#define EACH_STRUCTURE                                                                             \
+    const AccelStructure structure = GENERATE(AccelStructure::bvh2, AccelStructure::grid);         \
+    INFO("through the " << scene::to_string(structure))
+
 struct Queries {
-    scene::Bvh bvh;
+    std::optional<scene::Bvh> bvh;
+    std::optional<scene::Grid> grid;
     std::vector<RayResult> results;  ///< one per ray, identical on both engines
-    /// The scene triangle behind an image (leaf-order) triangle index.
-    uint32_t scene_triangle(int32_t image_index) const { return bvh.triangle_order[image_index]; }
+    /// The scene triangle behind an image triangle index (the BVH's are in leaf order).
+    uint32_t scene_triangle(int32_t image_index) const {
+        return bvh ? bvh->triangle_order[size_t(image_index)] : uint32_t(image_index);
+    }
+    /// Most nodes (cells) one ray can visit: every node once; a straight line crosses at most
+    /// res_x + res_y + res_z - 2 cells.
+    uint64_t most_nodes() const {
+        return bvh ? bvh->nodes.size()
+                   : uint64_t(grid->stats.resolution[0]) + grid->stats.resolution[1] +
+                         grid->stats.resolution[2] - 2;
+    }
 };
 
 scene::Bvh bvh_for(const Mesh& mesh) {
@@ -126,11 +146,20 @@ scene::Bvh bvh_for(const Mesh& mesh) {
     return scene::build_bvh(mesh, config);
 }
 
-/// Runs ray_query over `rays` on both engines; REQUIREs that they agree bit for bit.
-Queries run_queries(const Mesh& mesh, const std::vector<Ray>& rays) {
-    Queries q{bvh_for(mesh), {}};
+/// Runs the structure's ray_query kernel over `rays` on both engines; REQUIREs that they agree
+/// bit for bit.
+Queries run_queries(const Mesh& mesh, const std::vector<Ray>& rays, AccelStructure structure) {
+    Queries q;
+    image::Accel accel;
+    if (structure == AccelStructure::grid) {
+        q.grid = scene::build_grid(mesh);
+        accel = &*q.grid;
+    } else {
+        q.bvh = bvh_for(mesh);
+        accel = &*q.bvh;
+    }
     test::RayQueryRun run =
-        test::run_ray_query(mesh, q.bvh, rays, 20000 * uint64_t(rays.size()) + 100000);
+        test::run_ray_query(mesh, accel, rays, 20000 * uint64_t(rays.size()) + 100000);
     // A kRayFromSurface query whose first ray hit traces a second one.
     size_t second_rays = 0;
     for (size_t i = 0; i < rays.size(); ++i)
@@ -165,14 +194,14 @@ std::vector<glm::vec3> vertices_and_edge_midpoints(const Mesh& mesh) {
 
 /// Rays from `inside` aimed exactly at every vertex and edge midpoint, closest- and any-hit:
 /// a closed mesh must catch every one (zero leaks) at t ~ 1 (the target is on the surface).
-void check_no_leaks(const Mesh& mesh, glm::vec3 inside) {
+void check_no_leaks(const Mesh& mesh, glm::vec3 inside, AccelStructure structure) {
     const std::vector<glm::vec3> targets = vertices_and_edge_midpoints(mesh);
     std::vector<Ray> rays;
     for (const glm::vec3& target : targets) {
         rays.push_back(make_ray(inside, target - inside, kInf));
         rays.push_back(make_ray(inside, target - inside, kInf, trax::layout::kRayAnyHit));
     }
-    const Queries q = run_queries(mesh, rays);
+    const Queries q = run_queries(mesh, rays, structure);
     size_t leaks = 0, closest_off = 0;
     for (size_t i = 0; i < rays.size(); ++i) {
         const RayResult& r = q.results[i];
@@ -190,6 +219,7 @@ void check_no_leaks(const Mesh& mesh, glm::vec3 inside) {
 }  // namespace
 
 TEST_CASE("robustness: rays at every vertex and edge of closed meshes never leak", "[robustness]") {
+    EACH_STRUCTURE;
     const Mesh cube = grid_cube(3), sphere = icosphere(2);
     struct Placement {
         const char* name;
@@ -205,20 +235,21 @@ TEST_CASE("robustness: rays at every vertex and edge of closed meshes never leak
         SECTION(std::string("grid cube, ") + p.name) {
             // The centre, and an off-centre point: different directions hit different edges.
             check_no_leaks(transformed(cube, p.scale, p.offset),
-                           glm::vec3(0.5f) * p.scale + p.offset);
+                           glm::vec3(0.5f) * p.scale + p.offset, structure);
             check_no_leaks(transformed(cube, p.scale, p.offset),
-                           glm::vec3(0.3f, 0.55f, 0.7f) * p.scale + p.offset);
+                           glm::vec3(0.3f, 0.55f, 0.7f) * p.scale + p.offset, structure);
         }
         SECTION(std::string("icosphere, ") + p.name) {
-            check_no_leaks(transformed(sphere, p.scale, p.offset), p.offset);
+            check_no_leaks(transformed(sphere, p.scale, p.offset), p.offset, structure);
             check_no_leaks(transformed(sphere, p.scale, p.offset),
-                           glm::vec3(0.2f, -0.3f, 0.1f) * p.scale + p.offset);
+                           glm::vec3(0.2f, -0.3f, 0.1f) * p.scale + p.offset, structure);
         }
     }
 }
 
 TEST_CASE("robustness: grazing rays inside a closed cube always hit, at the right distance",
           "[robustness]") {
+    EACH_STRUCTURE;
     const Mesh cube = grid_cube(4);
     std::vector<Ray> rays;
     std::vector<float> expected;
@@ -234,7 +265,7 @@ TEST_CASE("robustness: grazing rays inside a closed cube always hit, at the righ
             expected.push_back(std::min(0.9f, gap / std::max(rise, 1e-30f)));
         }
     }
-    const Queries q = run_queries(cube, rays);
+    const Queries q = run_queries(cube, rays, structure);
     for (size_t i = 0; i < rays.size(); ++i) {
         INFO("ray " << i);
         CHECK(q.results[i].triangle >= 0);
@@ -242,29 +273,47 @@ TEST_CASE("robustness: grazing rays inside a closed cube always hit, at the righ
     }
 }
 
-TEST_CASE("robustness: axis-aligned rays with the origin on BVH box planes", "[robustness]") {
+TEST_CASE("robustness: axis-aligned rays with the origin on BVH box and grid cell planes",
+          "[robustness]") {
+    EACH_STRUCTURE;
     // A 4x4 grid per face: leaf boxes have planes at multiples of 1/4 inside the cube.
     const Mesh cube = grid_cube(4);
-    const scene::Bvh bvh = bvh_for(cube);
+    // The planes the structure's traversal computes distances to: node boxes' or cell faces'.
+    std::array<std::vector<float>, 3> planes;
+    if (structure == AccelStructure::grid) {
+        const scene::Grid grid = scene::build_grid(cube);
+        for (int axis = 0; axis < 3; ++axis)
+            for (uint32_t c = 0; c <= grid.stats.resolution[size_t(axis)]; ++c) {
+                // As kernel/grid.hpp computes a cell face.
+                const float cell =
+                    (grid.hi[axis] - grid.lo[axis]) / float(grid.stats.resolution[size_t(axis)]);
+                planes[size_t(axis)].push_back(grid.lo[axis] + float(c) * cell);
+            }
+    } else {
+        for (const scene::BvhNode& node : bvh_for(cube).nodes)
+            for (int axis = 0; axis < 3; ++axis) {
+                planes[size_t(axis)].push_back(node.bounds.lo[axis]);
+                planes[size_t(axis)].push_back(node.bounds.hi[axis]);
+            }
+    }
     std::vector<Ray> rays;
     std::vector<float> expected;
-    for (const scene::BvhNode& node : bvh.nodes)
-        for (int axis = 0; axis < 3; ++axis)
-            for (float plane : {node.bounds.lo[axis], node.bounds.hi[axis]}) {
-                if (plane <= 0.0f || plane >= 1.0f) continue;  // only planes inside the cube
-                for (int dir_axis = 0; dir_axis < 3; ++dir_axis)
-                    for (float sign : {-1.0f, 1.0f}) {
-                        glm::vec3 origin(0.3f, 0.6f, 0.45f);
-                        origin[axis] = plane;
-                        glm::vec3 dir(0.0f);
-                        dir[dir_axis] = sign;
-                        rays.push_back(make_ray(origin, dir, kInf));
-                        // The unit cube's face along the direction: independent of the mesh.
-                        expected.push_back(sign > 0 ? 1.0f - origin[dir_axis] : origin[dir_axis]);
-                    }
-            }
+    for (int axis = 0; axis < 3; ++axis)
+        for (float plane : planes[size_t(axis)]) {
+            if (plane <= 0.0f || plane >= 1.0f) continue;  // only planes inside the cube
+            for (int dir_axis = 0; dir_axis < 3; ++dir_axis)
+                for (float sign : {-1.0f, 1.0f}) {
+                    glm::vec3 origin(0.3f, 0.6f, 0.45f);
+                    origin[axis] = plane;
+                    glm::vec3 dir(0.0f);
+                    dir[dir_axis] = sign;
+                    rays.push_back(make_ray(origin, dir, kInf));
+                    // The unit cube's face along the direction: independent of the mesh.
+                    expected.push_back(sign > 0 ? 1.0f - origin[dir_axis] : origin[dir_axis]);
+                }
+        }
     REQUIRE(!rays.empty());
-    const Queries q = run_queries(cube, rays);
+    const Queries q = run_queries(cube, rays, structure);
     size_t wrong = 0;
     for (size_t i = 0; i < rays.size(); ++i)
         wrong += q.results[i].triangle < 0 || std::abs(q.results[i].t - expected[i]) > 1e-6f;
@@ -274,6 +323,7 @@ TEST_CASE("robustness: axis-aligned rays with the origin on BVH box planes", "[r
 
 TEST_CASE("robustness: degenerate and zero-area triangles are never hit and give no NaN",
           "[robustness]") {
+    EACH_STRUCTURE;
     Mesh mesh = grid_cube(2);
     const size_t first_degenerate = mesh.size();
     const glm::vec3 a(2.0f, 0.5f, 0.5f), b(3.0f, 0.5f, 0.5f), c(2.5f, 0.5f, 0.5f);
@@ -290,7 +340,7 @@ TEST_CASE("robustness: degenerate and zero-area triangles are never hit and give
             rays.push_back(make_ray(o, target - o, kInf));
             rays.push_back(make_ray(o, target - o, kInf, trax::layout::kRayAnyHit));
         }
-    const Queries q = run_queries(mesh, rays);
+    const Queries q = run_queries(mesh, rays, structure);
     for (size_t i = 0; i < rays.size(); ++i) {
         const RayResult& r = q.results[i];
         INFO("ray " << i);
@@ -301,6 +351,7 @@ TEST_CASE("robustness: degenerate and zero-area triangles are never hit and give
 
 TEST_CASE("robustness: NaN and infinite rays terminate without overflow, NaN rays hit nothing",
           "[robustness]") {
+    EACH_STRUCTURE;
     const Mesh sphere = icosphere(2);
     const glm::vec3 o(0.1f, 0.2f, 0.3f), d(0.3f, -0.5f, 0.8f);
     std::vector<Ray> rays;
@@ -324,18 +375,19 @@ TEST_CASE("robustness: NaN and infinite rays terminate without overflow, NaN ray
     rays.push_back(make_ray(glm::vec3(kNaN), glm::vec3(kNaN), kNaN));
     must_miss.push_back(true);
 
-    const Queries q = run_queries(sphere, rays);  // finite instruction budget: no hang
+    const Queries q = run_queries(sphere, rays, structure);  // finite instruction budget: no hang
     for (size_t i = 0; i < rays.size(); ++i) {
         const RayResult& r = q.results[i];
         INFO("ray " << i);
         CHECK(r.stack_overflows == 0);
-        CHECK(r.nodes_visited <= q.bvh.nodes.size());
+        CHECK(r.nodes_visited <= q.most_nodes());
         if (must_miss[i]) CHECK(r.triangle == -1);
         if (r.triangle >= 0) CHECK(std::isfinite(r.t));
     }
 }
 
 TEST_CASE("robustness: rays leaving a surface never hit their own triangle", "[robustness]") {
+    EACH_STRUCTURE;
     const float scales[] = {1.0f, 1e-4f, 1e4f, 100.0f};
     const glm::vec3 offsets[] = {glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f),
                                  glm::vec3(1e5f, 1e5f, -1e5f)};
@@ -362,7 +414,7 @@ TEST_CASE("robustness: rays leaving a surface never hit their own triangle", "[r
                 }
             }
         }
-        const Queries q = run_queries(mesh, rays);
+        const Queries q = run_queries(mesh, rays, structure);
         size_t surface_misses = 0, self_hits = 0, inward_misses = 0, outward_hits = 0;
         for (size_t i = 0; i < rays.size(); ++i) {
             const RayResult& r = q.results[i];
@@ -385,6 +437,7 @@ TEST_CASE("robustness: rays leaving a surface never hit their own triangle", "[r
 
 TEST_CASE("robustness: a hit point on a large floor at y = 0 does not shadow itself",
           "[robustness]") {
+    EACH_STRUCTURE;
     // The Cornell box's floor seen from its camera: with the paper's absolute "near the
     // origin" offset (1/65536) half of these points were shadowed by the floor.
     const glm::vec3 a(0.0f, 0.0f, 0.0f), b(556.0f, 0.0f, 0.0f), c(556.0f, 0.0f, 559.0f),
@@ -401,7 +454,7 @@ TEST_CASE("robustness: a hit point on a large floor at y = 0 does not shadow its
                                         trax::layout::kRayFromSurface | trax::layout::kRayAnyHit,
                                         light));
         }
-    const Queries q = run_queries(floor, rays);
+    const Queries q = run_queries(floor, rays, structure);
     size_t missed = 0, shadowed = 0;
     for (const RayResult& r : q.results) {
         missed += r.surface_triangle < 0;
