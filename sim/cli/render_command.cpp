@@ -226,7 +226,12 @@ Command add_render_command(CLI::App& app) {
                      "Acceleration structure: bvh2 (binary BVH, kernel tracer) or grid (uniform "
                      "grid, kernel tracer_grid); with --kernel, the one the kernel traverses "
                      "(docs/accel.md) [default: the kernel's]")
-        ->check(CLI::IsMember({"bvh2", "grid"}));
+        ->check(CLI::IsMember([] {
+            std::vector<std::string> names;
+            for (const scene::AccelInfo& info : scene::kAccelStructures)
+                names.emplace_back(info.name);
+            return names;
+        }()));
     command
         ->add_option("--grid-resolution", o->grid_resolution,
                      "Uniform grid: cells along the scene's longest axis, the others in "

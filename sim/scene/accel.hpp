@@ -26,7 +26,6 @@ constexpr std::array kAccelStructures = {
     AccelInfo{AccelStructure::bvh2, "bvh2", "tracer", "the binary BVH"},
     AccelInfo{AccelStructure::grid, "grid", "tracer_grid", "the uniform grid"},
 };
-constexpr std::string_view kAccelNames = "bvh2, grid";
 
 constexpr AccelInfo accel_info(AccelStructure structure) {
     for (const AccelInfo& info : kAccelStructures)
