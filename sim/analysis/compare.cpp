@@ -219,8 +219,9 @@ std::vector<SetupDifference> setup_differences(const std::vector<StatsFile>& run
         const std::string text = run.run_text(key);
         return text.empty() ? std::string(kAbsent) : text;
     };
-    for (const char* field : {"scene", "kernel", "engine", "accel", "grid_resolution",
-                              "grid_density", "bvh_builder", "max_leaf"}) {
+    for (const char* field :
+         {"scene", "kernel", "engine", "accel", "grid_resolution", "grid_density", "bvh_builder",
+          "max_leaf", "bvh_order", "bvh_align_pairs"}) {
         std::vector<std::string> values;
         for (const StatsFile& run : runs)
             values.push_back(run_field(run, field));

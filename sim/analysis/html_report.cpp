@@ -189,8 +189,10 @@ std::string run_line(const StatsFile& run) {
     else if (accel == "none")
         parts.push_back("no acceleration structure");
     else if (!field("bvh_builder").empty())
-        parts.push_back(
-            fmt::format("BVH {}, max_leaf {}", field("bvh_builder"), field("max_leaf")));
+        parts.push_back(fmt::format(
+            "BVH {}, max_leaf {}{}{}", field("bvh_builder"), field("max_leaf"),
+            field("bvh_order").empty() ? "" : fmt::format(", nodes {}", field("bvh_order")),
+            field("bvh_align_pairs") == "true" ? ", pairs line-aligned" : ""));
     std::string line;
     for (const std::string& part : parts)
         line += (line.empty() ? "" : " &middot; ") + escape(part);

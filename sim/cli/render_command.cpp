@@ -41,6 +41,8 @@ struct RenderCommandOptions {
     std::vector<std::string> overrides;
     std::string bvh = "sweep";
     uint32_t max_leaf = 8;
+    std::string bvh_order = scene::to_string(scene::BvhConfig{}.order);
+    bool bvh_align_pairs = false;
     bool native = false;
     bool no_fork = false;
     std::string timing = "cycle";
@@ -111,6 +113,8 @@ int run_render(RenderCommandOptions& o) {
                           : o.bvh == "median" ? scene::BvhBuilder::median
                                               : scene::BvhBuilder::sweep;
     options.bvh.max_leaf_size = o.max_leaf;
+    options.bvh.order = *scene::find_bvh_order(o.bvh_order);
+    options.bvh.align_pairs = o.bvh_align_pairs;
 
     // Bad output paths are found now, not after a render that may take hours.
     const std::filesystem::path output =
@@ -266,6 +270,17 @@ Command add_render_command(CLI::App& app) {
     command->add_option("--max-leaf", o->max_leaf, "Most triangles in one BVH leaf")
         ->check(CLI::Range(1, 8))
         ->capture_default_str();
+    std::vector<std::string> orders;
+    for (scene::BvhOrder order : scene::kBvhOrders)
+        orders.emplace_back(scene::to_string(order));
+    command
+        ->add_option("--bvh-order", o->bvh_order,
+                     "Order of the BVH nodes in memory (docs/accel.md); moves traffic, never "
+                     "the image")
+        ->check(CLI::IsMember(orders))
+        ->capture_default_str();
+    command->add_flag("--bvh-align-pairs", o->bvh_align_pairs,
+                      "Start every BVH sibling pair on a 64-byte line (docs/accel.md)");
     // The same limits as the scene file's [image] keys (docs/scenes.md).
     command->add_option("--width", o->width, "Image width in pixels, instead of the scene's")
         ->check(whole_number_in(1, 16384));

@@ -1,6 +1,7 @@
 #include "sim/image/memory_image.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -44,29 +45,61 @@ void write(std::vector<uint32_t>& words, int32_t addr, const Record& record) {
     std::memcpy(words.data() + addr, &record, sizeof(Record));
 }
 
-/// Re-lays the builder's depth-first nodes (left child next, right child anywhere) so that the
-/// two children of every interior node are adjacent, as layout::BvhNode requires; breadth-first
-/// order does that and keeps the top levels of the tree together in a few cache lines.
-std::vector<layout::BvhNode> compile_bvh(const scene::Bvh& bvh) {
-    std::vector<layout::BvhNode> out;
-    out.reserve(bvh.nodes.size());
-    std::vector<uint32_t> queue{0};  // builder node indices, in output order
-    queue.reserve(bvh.nodes.size());
-    for (size_t i = 0; i < queue.size(); ++i) {
-        const scene::BvhNode& n = bvh.nodes[queue[i]];
-        layout::BvhNode node{};
-        put(node.bounds_min, n.bounds.lo);
-        put(node.bounds_max, n.bounds.hi);
-        if (n.is_leaf()) {
-            node.first = int32_t(n.first_triangle);
-            node.count = int32_t(n.triangle_count);
-        } else {
-            node.first = int32_t(queue.size());
-            node.count = 0;
-            queue.push_back(queue[i] + 1);
-            queue.push_back(n.right_child);
+/// The builder's interior nodes (each the parent of one sibling pair) in the order their pairs
+/// are laid out (scene::BvhOrder). Builder nodes are depth-first: the left child of interior
+/// node p is p + 1, the right one is at right_child.
+std::vector<uint32_t> pair_order(const scene::Bvh& bvh, scene::BvhOrder order) {
+    const auto interior = [&](uint32_t n) { return !bvh.nodes[n].is_leaf(); };
+    const auto children = [&](uint32_t p) {
+        return std::array<uint32_t, 2>{p + 1, bvh.nodes[p].right_child};
+    };
+    std::vector<uint32_t> out;
+    if (!interior(0)) return out;
+    out.reserve(bvh.nodes.size() / 2);
+    if (order == scene::BvhOrder::breadth_first) {
+        out.push_back(0);
+        for (size_t i = 0; i < out.size(); ++i)
+            for (uint32_t c : children(out[i]))
+                if (interior(c)) out.push_back(c);
+    } else if (order == scene::BvhOrder::depth_first) {
+        std::vector<uint32_t> stack{0};
+        while (!stack.empty()) {
+            const uint32_t p = stack.back();
+            stack.pop_back();
+            out.push_back(p);
+            const auto [left, right] = children(p);
+            if (interior(right)) stack.push_back(right);
+            if (interior(left)) stack.push_back(left);
         }
-        out.push_back(node);
+    } else {
+        // Height of each pair's subtree in the tree of pairs, children before parents: a
+        // child's builder index is larger than its parent's.
+        std::vector<uint32_t> height(bvh.nodes.size(), 0);
+        for (size_t n = bvh.nodes.size(); n-- > 0;)
+            if (interior(uint32_t(n)))
+                for (uint32_t c : children(uint32_t(n)))
+                    height[n] = std::max(height[n], interior(c) ? height[c] + 1 : 1);
+        // Lays out the top `levels` levels of p's subtree: the top half, then each subtree
+        // hanging below it, left to right.
+        const auto lay_out = [&](const auto& self, uint32_t p, uint32_t levels) -> void {
+            if (levels == 1) {
+                out.push_back(p);
+                return;
+            }
+            const uint32_t top = levels / 2;
+            self(self, p, top);
+            std::vector<uint32_t> frontier{p};
+            for (uint32_t level = 0; level < top; ++level) {
+                std::vector<uint32_t> next;
+                for (uint32_t q : frontier)
+                    for (uint32_t c : children(q))
+                        if (interior(c)) next.push_back(c);
+                frontier.swap(next);
+            }
+            for (uint32_t q : frontier)
+                self(self, q, levels - top);
+        };
+        lay_out(lay_out, 0, height[0]);
     }
     return out;
 }
@@ -102,6 +135,33 @@ std::vector<layout::Emitter> compile_emitters(const std::vector<layout::Triangle
 
 }  // namespace
 
+std::vector<layout::BvhNode> compile_bvh(const scene::Bvh& bvh, scene::BvhOrder order,
+                                         bool align_pairs) {
+    const std::vector<uint32_t> pairs = pair_order(bvh, order);
+    const uint32_t first_pair = align_pairs ? 2 : 1;
+    // Output index of each builder node.
+    std::vector<uint32_t> slot(bvh.nodes.size(), 0);
+    for (size_t j = 0; j < pairs.size(); ++j) {
+        slot[pairs[j] + 1] = first_pair + 2 * uint32_t(j);
+        slot[bvh.nodes[pairs[j]].right_child] = first_pair + 2 * uint32_t(j) + 1;
+    }
+    std::vector<layout::BvhNode> out(pairs.empty() ? 1 : first_pair + 2 * pairs.size());
+    for (size_t n = 0; n < bvh.nodes.size(); ++n) {
+        const scene::BvhNode& b = bvh.nodes[n];
+        layout::BvhNode& node = out[slot[n]];
+        put(node.bounds_min, b.bounds.lo);
+        put(node.bounds_max, b.bounds.hi);
+        if (b.is_leaf()) {
+            node.first = int32_t(b.first_triangle);
+            node.count = int32_t(b.triangle_count);
+        } else {
+            node.first = int32_t(slot[n + 1]);
+            node.count = 0;
+        }
+    }
+    return out;
+}
+
 MemoryImage build_memory_image(const scene::Scene& scene, Accel accel, uint32_t threads,
                                std::span<const layout::Ray> rays,
                                std::optional<uint32_t> extras_seed) {
@@ -132,7 +192,7 @@ MemoryImage build_memory_image(const scene::Scene& scene, Accel accel, uint32_t 
         return int32_t(n);
     };
     std::vector<layout::BvhNode> nodes;
-    if (bvh != nullptr) nodes = compile_bvh(*bvh);
+    if (bvh != nullptr) nodes = compile_bvh(*bvh, accel.bvh_order, accel.bvh_align_pairs);
     h.lights.count = checked_count(scene.lights.size(), "lights");
     h.materials.count = checked_count(scene.materials.size(), "materials");
     h.triangles.count = checked_count(scene.triangles.size(), "triangles");

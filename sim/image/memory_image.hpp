@@ -39,11 +39,22 @@ struct MemoryImage {
 /// traverses (or none, for brute force).
 struct Accel {
     const scene::Bvh* bvh = nullptr;
+    scene::BvhOrder bvh_order = scene::BvhOrder::breadth_first;  ///< scene::BvhConfig::order
+    bool bvh_align_pairs = false;                                ///< scene::BvhConfig::align_pairs
     const scene::Grid* grid = nullptr;
     Accel(std::nullptr_t = nullptr) {}
-    Accel(const scene::Bvh* b) : bvh(b) {}
+    Accel(const scene::Bvh* b, scene::BvhOrder order = scene::BvhOrder::breadth_first,
+          bool align_pairs = false)
+        : bvh(b), bvh_order(order), bvh_align_pairs(align_pairs) {}
     Accel(const scene::Grid* g) : grid(g) {}
 };
+
+/// The BVH section: the builder's nodes as layout::BvhNode wants them, the root at index 0 and
+/// the two children of every interior node side by side, their pairs in `order`; with
+/// `align_pairs`, index 1 is left unused (zeroed) so that every pair starts on a 64-byte
+/// boundary (the section starts on one). Leaf ranges index the triangles in leaf order.
+std::vector<trax::layout::BvhNode> compile_bvh(const scene::Bvh& bvh, scene::BvhOrder order,
+                                               bool align_pairs);
 
 /// Lays the scene out. With a BVH, triangles are stored in leaf order and nodes with sibling
 /// pairs adjacent, as the traversal kernel expects; without one, the BVH section is left out.

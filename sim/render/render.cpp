@@ -197,7 +197,9 @@ RenderResult render(const RenderOptions& options) {
         result.grid = grid->stats;
     }
     result.threads = options.chip.chip.num_tms * options.chip.chip.tps_per_tm;
-    const image::Accel accel = bvh ? image::Accel(&*bvh) : grid ? image::Accel(&*grid) : nullptr;
+    const image::Accel accel = bvh ? image::Accel(&*bvh, options.bvh.order, options.bvh.align_pairs)
+                               : grid ? image::Accel(&*grid)
+                                      : nullptr;
     result.image = image::build_memory_image(result.scene, accel, result.threads, {},
                                              kernel.uses_extras() ? std::optional(options.seed)
                                                                   : std::nullopt);

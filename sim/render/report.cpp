@@ -507,6 +507,8 @@ nlohmann::ordered_json stats_document(const RenderOptions& options, const Render
     }
     run["bvh_builder"] = scene::to_string(options.bvh.builder);
     run["max_leaf"] = options.bvh.max_leaf_size;
+    run["bvh_order"] = scene::to_string(options.bvh.order);
+    run["bvh_align_pairs"] = options.bvh.align_pairs;
     run["width"] = r.scene.width;
     run["height"] = r.scene.height;
     run["samples_per_pixel"] = r.scene.samples_per_pixel;

@@ -43,6 +43,18 @@ const char* to_string(BvhBuilder builder) {
                                           : "median";
 }
 
+const char* to_string(BvhOrder order) {
+    return order == BvhOrder::breadth_first ? "breadth-first"
+           : order == BvhOrder::depth_first ? "depth-first"
+                                            : "van-emde-boas";
+}
+
+std::optional<BvhOrder> find_bvh_order(std::string_view name) {
+    for (BvhOrder order : kBvhOrders)
+        if (name == to_string(order)) return order;
+    return std::nullopt;
+}
+
 namespace {
 
 /// A box that starts empty and grows; converted to Aabb only once it holds something.

@@ -4,7 +4,9 @@
 // splits, as in MacDonald & Booth 1990 / Wald et al. 2007 "Ray tracing deformable scenes").
 #pragma once
 #include <cstdint>
+#include <optional>
 #include <span>
+#include <string_view>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -33,6 +35,21 @@ struct BvhNode {
 /// the baseline the SAH builders are measured against (docs/course/experiments.md).
 enum class BvhBuilder { binned, sweep, median };
 
+/// The order the scene compiler lays the nodes out in (image::build_memory_image). The image
+/// stores the two children of a node side by side (a sibling pair, 64 bytes), so every order is
+/// an order of sibling pairs after the root; it moves which nodes share cache lines and DRAM
+/// rows, never the tree or the image.
+///   breadth_first: level by level, so the top levels share a few lines.
+///   depth_first: pre-order, a pair's left child's pair right after it (the path a ray takes
+///     most often lies close together).
+///   van_emde_boas: cache-oblivious (van Emde Boas 1977; Bender, Demaine and Farach-Colton
+///     2000; for BVHs, Yoon and Manocha 2006): the tree of pairs is cut at half its height, the
+///     top stored first, then each bottom subtree, recursively, so every subtree of height 2^k
+///     is contiguous, whatever the line and row sizes.
+enum class BvhOrder { breadth_first, depth_first, van_emde_boas };
+inline constexpr BvhOrder kBvhOrders[] = {BvhOrder::breadth_first, BvhOrder::depth_first,
+                                          BvhOrder::van_emde_boas};
+
 struct BvhConfig {
     BvhBuilder builder = BvhBuilder::sweep;
     /// Most triangles in one leaf (1..8). Smaller leaves are made when the SAH says so.
@@ -45,6 +62,12 @@ struct BvhConfig {
     uint32_t traversal_stack_entries = 32;
     /// Bins per axis for the binned builder (2..256).
     uint32_t bins = 32;
+    /// How the scene compiler lays the nodes out; the builder ignores both.
+    BvhOrder order = BvhOrder::breadth_first;
+    /// Leave the node after the root unused, so that every sibling pair starts on a 64-byte
+    /// boundary and fills one line (32 bytes more). Off, the root fills the first half line and
+    /// every pair straddles two lines: the layout the reference figures were measured with.
+    bool align_pairs = false;
 };
 
 struct BvhStats {
@@ -75,5 +98,8 @@ Bvh build_bvh(std::span<const Triangle> triangles, const BvhConfig& config = {})
 double sah_cost(const Bvh& bvh);
 
 const char* to_string(BvhBuilder builder);
+const char* to_string(BvhOrder order);
+/// The order that to_string names `name`, or nullopt.
+std::optional<BvhOrder> find_bvh_order(std::string_view name);
 
 }  // namespace tpsim::scene

@@ -45,6 +45,8 @@ render::RenderOptions render_options(const JobRun& run) {
                           : run.bvh == "median" ? scene::BvhBuilder::median
                                                 : scene::BvhBuilder::sweep;
     options.bvh.max_leaf_size = run.max_leaf;
+    options.bvh.order = *scene::find_bvh_order(run.bvh_order);
+    options.bvh.align_pairs = run.bvh_align_pairs;
     if (!run.accel.empty()) options.accel = scene::find_accel(run.accel)->structure;
     options.grid.resolution = run.grid_resolution;
     options.grid.density = run.grid_density;

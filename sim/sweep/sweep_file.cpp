@@ -11,6 +11,7 @@
 #include "sim/core/input_file.hpp"
 #include "sim/core/toml_nesting.hpp"
 #include "sim/scene/accel.hpp"
+#include "sim/scene/bvh.hpp"
 #include "sim/scene/grid.hpp"
 #include "sim/sweep/sweep.hpp"
 
@@ -200,9 +201,9 @@ private:
     }
 
     std::string one_of(const std::string& name, const Value& v,
-                       std::initializer_list<const char*> allowed) const {
+                       const std::vector<std::string>& allowed) const {
         if (v.value.is_string())
-            for (const char* a : allowed)
+            for (const std::string& a : allowed)
                 if (v.value.get<std::string>() == a) return a;
         fail(v.line, fmt::format("{} must be one of {}, got {}", name, fmt::join(allowed, ", "),
                                  v.value.dump()));
@@ -251,13 +252,25 @@ private:
                 fail(v.line, fmt::format("config: {}", e.what()));
             }
         } else if (name == "accel") {
-            run.accel = one_of(name, v, {"bvh2", "grid"});
+            std::vector<std::string> structures;
+            for (const scene::AccelInfo& info : scene::kAccelStructures)
+                structures.emplace_back(info.name);
+            run.accel = one_of(name, v, structures);
         } else if (name == "grid_resolution") {
             run.grid_resolution = uint32_t(integer(name, v, 0, scene::kGridMaxResolution));
         } else if (name == "grid_density") {
             run.grid_density = number(name, v, 1.0 / 1024, scene::kGridMaxDensity);
         } else if (name == "bvh") {
             run.bvh = one_of(name, v, {"sweep", "binned", "median"});
+        } else if (name == "bvh_order") {
+            std::vector<std::string> orders;
+            for (scene::BvhOrder order : scene::kBvhOrders)
+                orders.emplace_back(scene::to_string(order));
+            run.bvh_order = one_of(name, v, orders);
+        } else if (name == "bvh_align_pairs") {
+            if (!v.value.is_boolean())
+                fail(v.line, fmt::format("{} must be true or false, got {}", name, v.value.dump()));
+            run.bvh_align_pairs = v.value.get<bool>();
         } else if (name == "max_leaf") {
             run.max_leaf = uint32_t(integer(name, v, 1, 8));
         } else if (name == "width") {
@@ -492,6 +505,8 @@ void write_plan(const Sweep& sweep, const std::filesystem::path& dir) {
                           {"grid_density", r.grid_density},
                           {"bvh", r.bvh},
                           {"max_leaf", r.max_leaf},
+                          {"bvh_order", r.bvh_order},
+                          {"bvh_align_pairs", r.bvh_align_pairs},
                           {"width", r.width},
                           {"height", r.height},
                           {"spp", r.spp},
@@ -559,6 +574,8 @@ Sweep read_plan(const std::filesystem::path& dir) {
             job.run.grid_density = r.at("grid_density").get<double>();
             job.run.bvh = r.at("bvh").get<std::string>();
             job.run.max_leaf = r.at("max_leaf").get<uint32_t>();
+            job.run.bvh_order = r.at("bvh_order").get<std::string>();
+            job.run.bvh_align_pairs = r.at("bvh_align_pairs").get<bool>();
             job.run.width = r.at("width").get<uint32_t>();
             job.run.height = r.at("height").get<uint32_t>();
             job.run.spp = r.at("spp").get<uint32_t>();

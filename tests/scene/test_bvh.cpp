@@ -1,5 +1,6 @@
 #include <bit>
 #include <cmath>
+#include <deque>
 #include <filesystem>
 #include <limits>
 #include <random>
@@ -8,6 +9,7 @@
 #include <oneapi/tbb/global_control.h>
 #include <oneapi/tbb/task_arena.h>
 
+#include "sim/image/memory_image.hpp"
 #include "sim/scene/bvh.hpp"
 #include "sim/scene/load_scene.hpp"
 #include "sim/scene/procedural.hpp"
@@ -371,4 +373,140 @@ TEST_CASE("The median builder halves every node: valid, balanced, no better than
     check_invariants(shallow, strip, tight);
     CHECK(shallow.stats.depth_limited_nodes == 0);
     CHECK(std::string(to_string(BvhBuilder::median)) == "median");
+}
+
+namespace {
+
+using tpsim::image::compile_bvh;
+using ImageNode = trax::layout::BvhNode;
+
+/// Interior image nodes (their `first`, the index of their pair) in breadth-first (FIFO) or
+/// depth-first (pre-order, left first) order of the image tree.
+std::vector<int32_t> pairs_in_walk(const std::vector<ImageNode>& nodes, bool breadth_first) {
+    std::vector<int32_t> out;
+    std::deque<int32_t> pending{0};
+    while (!pending.empty()) {
+        const int32_t n = breadth_first ? pending.front() : pending.back();
+        breadth_first ? pending.pop_front() : pending.pop_back();
+        if (nodes[size_t(n)].count != 0) continue;
+        const int32_t first = nodes[size_t(n)].first;
+        out.push_back(first);
+        if (breadth_first) {
+            pending.push_back(first);
+            pending.push_back(first + 1);
+        } else {
+            pending.push_back(first + 1);
+            pending.push_back(first);
+        }
+    }
+    return out;
+}
+
+/// The image tree is the builder's tree: the same boxes and leaf ranges, node for node, every
+/// image node but the padding reached once; pairs line-aligned when asked.
+void check_same_tree(const Bvh& bvh, const std::vector<ImageNode>& nodes, bool align_pairs) {
+    REQUIRE(nodes.size() == bvh.nodes.size() + (align_pairs ? 1 : 0));
+    std::vector<int> reached(nodes.size(), 0);
+    std::vector<std::pair<uint32_t, int32_t>> pending{{0, 0}};  // builder node, image node
+    while (!pending.empty()) {
+        const auto [b, i] = pending.back();
+        pending.pop_back();
+        REQUIRE(size_t(i) < nodes.size());
+        ++reached[size_t(i)];
+        const BvhNode& built = bvh.nodes[b];
+        const ImageNode& laid = nodes[size_t(i)];
+        for (int k = 0; k < 3; ++k) {
+            REQUIRE(laid.bounds_min[k] == built.bounds.lo[k]);
+            REQUIRE(laid.bounds_max[k] == built.bounds.hi[k]);
+        }
+        if (built.is_leaf()) {
+            REQUIRE(laid.count == int32_t(built.triangle_count));
+            REQUIRE(laid.first == int32_t(built.first_triangle));
+        } else {
+            REQUIRE(laid.count == 0);
+            if (align_pairs) REQUIRE(laid.first % 2 == 0);  // 32-byte nodes: a 64-byte line
+            pending.push_back({b + 1, laid.first});
+            pending.push_back({built.right_child, laid.first + 1});
+        }
+    }
+    for (size_t i = 0; i < nodes.size(); ++i) {
+        INFO("image node " << i);
+        CHECK(reached[i] == (align_pairs && i == 1 ? 0 : 1));
+    }
+}
+
+/// Depth of each pair (by its index in memory) in the tree of pairs, the root's pair at 0.
+std::vector<uint32_t> pair_depths(const std::vector<ImageNode>& nodes, int32_t first_pair) {
+    std::vector<uint32_t> depth(nodes.size() / 2 + 1, 0);
+    std::vector<std::pair<int32_t, uint32_t>> pending{{0, 0}};
+    while (!pending.empty()) {
+        const auto [n, d] = pending.back();
+        pending.pop_back();
+        if (nodes[size_t(n)].count != 0) continue;
+        const int32_t first = nodes[size_t(n)].first;
+        depth[size_t((first - first_pair) / 2)] = d;
+        pending.push_back({first, d + 1});
+        pending.push_back({first + 1, d + 1});
+    }
+    return depth;
+}
+
+}  // namespace
+
+TEST_CASE("Every node order lays out the builder's tree, pairs in the order it names",
+          "[bvh][layout]") {
+    // A random soup (bushy) and a geometric strip (a deep, lopsided tree).
+    const auto soup = random_soup(5000, 42);
+    const auto strip = geometric_strip(3000);
+    for (const auto* triangles : {&soup, &strip}) {
+        const Bvh bvh = build_bvh(*triangles);
+        REQUIRE(bvh.stats.max_depth >= 8);
+        for (BvhOrder order : kBvhOrders)
+            for (bool align : {false, true}) {
+                INFO(to_string(order)
+                     << (align ? ", aligned" : "") << ", " << triangles->size() << " triangles");
+                const std::vector<ImageNode> nodes = compile_bvh(bvh, order, align);
+                check_same_tree(bvh, nodes, align);
+                const int32_t first_pair = align ? 2 : 1;
+                const uint32_t pairs = uint32_t(nodes.size() - size_t(first_pair)) / 2;
+                std::vector<int32_t> consecutive(pairs);
+                for (uint32_t j = 0; j < pairs; ++j)
+                    consecutive[j] = first_pair + 2 * int32_t(j);
+                if (order == BvhOrder::breadth_first)
+                    CHECK(pairs_in_walk(nodes, true) == consecutive);
+                if (order == BvhOrder::depth_first)
+                    CHECK(pairs_in_walk(nodes, false) == consecutive);
+                if (order == BvhOrder::van_emde_boas) {
+                    // The top half of the tree of pairs comes first, and is not the breadth-
+                    // or depth-first order.
+                    const std::vector<uint32_t> depth = pair_depths(nodes, first_pair);
+                    const uint32_t height =
+                        *std::max_element(depth.begin(), depth.begin() + pairs) + 1;
+                    const uint32_t top = height / 2;
+                    const auto in_top = uint32_t(std::count_if(
+                        depth.begin(), depth.begin() + pairs, [&](uint32_t d) { return d < top; }));
+                    for (uint32_t j = 0; j < pairs; ++j) {
+                        INFO("pair " << j);
+                        REQUIRE((depth[j] < top) == (j < in_top));
+                    }
+                    CHECK(pairs_in_walk(nodes, true) != consecutive);
+                    CHECK(pairs_in_walk(nodes, false) != consecutive);
+                }
+            }
+    }
+    for (BvhOrder order : kBvhOrders)
+        CHECK(find_bvh_order(to_string(order)) == order);
+    CHECK(!find_bvh_order("depth_first").has_value());
+}
+
+TEST_CASE("A tree that is one leaf lays out as one node in every order", "[bvh][layout]") {
+    const auto one = random_soup(1, 1);
+    const Bvh bvh = build_bvh(one);
+    REQUIRE(bvh.nodes.size() == 1);
+    for (BvhOrder order : kBvhOrders)
+        for (bool align : {false, true}) {
+            const std::vector<ImageNode> nodes = compile_bvh(bvh, order, align);
+            REQUIRE(nodes.size() == 1);
+            CHECK(nodes[0].count == 1);
+        }
 }

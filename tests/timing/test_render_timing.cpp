@@ -107,6 +107,37 @@ TEST_CASE("timing parameters never change the image", "[render][invariance]") {
     }
 }
 
+TEST_CASE("BVH node orders move the traffic, never the image or the instructions",
+          "[render][invariance][layout]") {
+    const auto reference = render_cornell(render::Engine::timing, tiny());
+    const auto stat = [](const render::RenderResult& result, const char* key) {
+        stats::Registry all;
+        render::register_stats(result, all);
+        return all.value(key);
+    };
+    const double unaligned_misses = stat(reference, "region/bvh_nodes/l1/misses");
+    for (scene::BvhOrder order : scene::kBvhOrders)
+        for (bool align : {false, true}) {
+            render::RenderOptions options;
+            options.scene = small_cornell();
+            options.kernel = TPSIM_KERNEL_DIR "/tracer.elf";
+            options.engine = render::Engine::timing;
+            options.chip = tiny();
+            options.bvh.order = order;
+            options.bvh.align_pairs = align;
+            const auto result = render::render(options);
+            INFO(scene::to_string(order) << (align ? ", aligned" : ""));
+            CHECK(same_bits(result.rgb, reference.rgb));
+            CHECK(result.instructions.total == reference.instructions.total);
+            CHECK(result.traversal.nodes_visited == reference.traversal.nodes_visited);
+            CHECK(result.image.header.bvh_nodes.count ==
+                  reference.image.header.bvh_nodes.count + (align ? 1 : 0));
+            // A 1 KiB L1: a pair that fills one line costs one miss where a straddling pair
+            // costs two.
+            if (align) CHECK(stat(result, "region/bvh_nodes/l1/misses") < unaligned_misses);
+        }
+}
+
 TEST_CASE("every key a cycle-level render registers is documented in docs/statistics.md",
           "[render][docs]") {
     const std::vector<std::regex> documented = documented_stat_patterns();
