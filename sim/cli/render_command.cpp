@@ -230,12 +230,7 @@ Command add_render_command(CLI::App& app) {
                      "Acceleration structure: bvh2 (binary BVH, kernel tracer) or grid (uniform "
                      "grid, kernel tracer_grid); with --kernel, the one the kernel traverses "
                      "(docs/accel.md) [default: the kernel's]")
-        ->check(CLI::IsMember([] {
-            std::vector<std::string> names;
-            for (const scene::AccelInfo& info : scene::kAccelStructures)
-                names.emplace_back(info.name);
-            return names;
-        }()));
+        ->check(CLI::IsMember(scene::accel_names()));
     command
         ->add_option("--grid-resolution", o->grid_resolution,
                      "Uniform grid: cells along the scene's longest axis, the others in "
@@ -270,14 +265,11 @@ Command add_render_command(CLI::App& app) {
     command->add_option("--max-leaf", o->max_leaf, "Most triangles in one BVH leaf")
         ->check(CLI::Range(1, 8))
         ->capture_default_str();
-    std::vector<std::string> orders;
-    for (scene::BvhOrder order : scene::kBvhOrders)
-        orders.emplace_back(scene::to_string(order));
     command
         ->add_option("--bvh-order", o->bvh_order,
                      "Order of the BVH nodes in memory (docs/accel.md); moves traffic, never "
                      "the image")
-        ->check(CLI::IsMember(orders))
+        ->check(CLI::IsMember(scene::bvh_order_names()))
         ->capture_default_str();
     command->add_flag("--bvh-align-pairs", o->bvh_align_pairs,
                       "Start every BVH sibling pair on a 64-byte line (docs/accel.md)");

@@ -4,7 +4,9 @@
 #pragma once
 #include <array>
 #include <optional>
+#include <string>
 #include <string_view>
+#include <vector>
 
 namespace tpsim::scene {
 
@@ -35,6 +37,14 @@ constexpr AccelInfo accel_info(AccelStructure structure) {
 
 constexpr std::string_view to_string(AccelStructure structure) {
     return accel_info(structure).name;
+}
+
+/// The structures' names, for the command line's and the sweep file's choices.
+inline std::vector<std::string> accel_names() {
+    std::vector<std::string> names;
+    for (const AccelInfo& info : kAccelStructures)
+        names.emplace_back(info.name);
+    return names;
 }
 
 constexpr std::optional<AccelInfo> find_accel(std::string_view name) {

@@ -49,6 +49,13 @@ const char* to_string(BvhOrder order) {
                                             : "van-emde-boas";
 }
 
+std::vector<std::string> bvh_order_names() {
+    std::vector<std::string> names;
+    for (BvhOrder order : kBvhOrders)
+        names.emplace_back(to_string(order));
+    return names;
+}
+
 std::optional<BvhOrder> find_bvh_order(std::string_view name) {
     for (BvhOrder order : kBvhOrders)
         if (name == to_string(order)) return order;

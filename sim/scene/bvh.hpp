@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -99,6 +100,8 @@ double sah_cost(const Bvh& bvh);
 
 const char* to_string(BvhBuilder builder);
 const char* to_string(BvhOrder order);
+/// Every order's name (to_string), for the command line's and the sweep file's choices.
+std::vector<std::string> bvh_order_names();
 /// The order that to_string names `name`, or nullopt.
 std::optional<BvhOrder> find_bvh_order(std::string_view name);
 

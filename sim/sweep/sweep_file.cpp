@@ -252,10 +252,7 @@ private:
                 fail(v.line, fmt::format("config: {}", e.what()));
             }
         } else if (name == "accel") {
-            std::vector<std::string> structures;
-            for (const scene::AccelInfo& info : scene::kAccelStructures)
-                structures.emplace_back(info.name);
-            run.accel = one_of(name, v, structures);
+            run.accel = one_of(name, v, scene::accel_names());
         } else if (name == "grid_resolution") {
             run.grid_resolution = uint32_t(integer(name, v, 0, scene::kGridMaxResolution));
         } else if (name == "grid_density") {
@@ -263,10 +260,7 @@ private:
         } else if (name == "bvh") {
             run.bvh = one_of(name, v, {"sweep", "binned", "median"});
         } else if (name == "bvh_order") {
-            std::vector<std::string> orders;
-            for (scene::BvhOrder order : scene::kBvhOrders)
-                orders.emplace_back(scene::to_string(order));
-            run.bvh_order = one_of(name, v, orders);
+            run.bvh_order = one_of(name, v, scene::bvh_order_names());
         } else if (name == "bvh_align_pairs") {
             if (!v.value.is_boolean())
                 fail(v.line, fmt::format("{} must be true or false, got {}", name, v.value.dump()));
