@@ -256,7 +256,7 @@ struct BruteForce {
 };
 
 /// The robust slab test of Ize, "Robust BVH Ray Traversal", JCGT 2(2), 2013, for a ray given
-/// by its origin and reciprocal direction, against the box at `node`, within [0, t_far].
+/// by its origin and reciprocal direction, against a box, within [0, t_far].
 /// Returns the entry distance, or a value > t_far for a miss (always a number, never NaN).
 /// - The exit distance is scaled by 1 + 2*gamma(3) (gamma(n) = n*eps/(1 - n*eps), eps = 2^-24)
 ///   so rounding in (bound - origin) * inverse can never make a box that the ray grazes look
@@ -265,20 +265,36 @@ struct BruteForce {
 ///   (bound - origin) * inverse is 0 * inf = NaN. The comparisons below are ordered so a NaN
 ///   distance never replaces the running entry/exit, i.e. such a slab does not clip the ray:
 ///   the ray lies in the box's face and counts as inside (conservative, no leak).
-[[gnu::always_inline]] inline float slab_entry(int node, Vec3 origin, Vec3 inverse, float t_far) {
+/// `box` gives the bounds, box.min(axis) and box.max(axis): a node's loads, or a wide node's
+/// decoded child box (wide_bvh.hpp).
+template <class Box>
+[[gnu::always_inline]] inline float slab_entry_of(const Box& box, Vec3 origin, Vec3 inverse,
+                                                  float t_far) {
     constexpr float kExitScale = 1.0f + 2.0f * (3.0f * 0x1p-24f / (1.0f - 3.0f * 0x1p-24f));
     float entry = 0.0f, exit = t_far;
     const float axes_o[3] = {origin.x, origin.y, origin.z};
     const float axes_i[3] = {inverse.x, inverse.y, inverse.z};
     for (int axis = 0; axis < 3; ++axis) {
-        const float t0 = (loadf(node, kNodeMin + axis) - axes_o[axis]) * axes_i[axis];
-        const float t1 = (loadf(node, kNodeMax + axis) - axes_o[axis]) * axes_i[axis];
+        const float t0 = (box.min(axis) - axes_o[axis]) * axes_i[axis];
+        const float t1 = (box.max(axis) - axes_o[axis]) * axes_i[axis];
         const float near = t0 < t1 ? t0 : t1;
         const float far = (t0 < t1 ? t1 : t0) * kExitScale;
         if (near > entry) entry = near;  // NaN compares false: the slab is ignored
         if (far < exit) exit = far;
     }
     return entry <= exit ? entry : t_far + 1.0f + trax_abs(t_far);
+}
+
+/// The box of the BVH node at word address `node` (scene_layout.hpp BvhNode), loaded as the
+/// slab test reads it.
+struct NodeBox {
+    int node;
+    [[gnu::always_inline]] float min(int axis) const { return loadf(node, kNodeMin + axis); }
+    [[gnu::always_inline]] float max(int axis) const { return loadf(node, kNodeMax + axis); }
+};
+
+[[gnu::always_inline]] inline float slab_entry(int node, Vec3 origin, Vec3 inverse, float t_far) {
+    return slab_entry_of(NodeBox{node}, origin, inverse, t_far);
 }
 
 /// Stack-based BVH traversal over the image's BVH (scene_layout.hpp BvhNode): nearer child

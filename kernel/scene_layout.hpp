@@ -14,7 +14,7 @@ namespace trax::layout {
 /// "TPSC" little-endian: lets the loader and the twin reject a memory image that is not a scene.
 constexpr uint32_t kMagic = 0x4353'5054u;
 /// Bumped whenever a struct below changes shape.
-constexpr uint32_t kVersion = 5;
+constexpr uint32_t kVersion = 6;
 
 /// Sections start on 16-word (64-byte, one cache line) boundaries so no record of one section
 /// shares a line with another section.
@@ -26,6 +26,10 @@ constexpr const char* kUsesBvhSymbol = "trax_uses_bvh";
 /// The same for a kernel that traverses the uniform grid (TRAX_USES_GRID): the host then builds
 /// the grid (and no BVH) and puts its AccelRecord, cells and references in the memory image.
 constexpr const char* kUsesGridSymbol = "trax_uses_grid";
+/// The same for a kernel that traverses a wide BVH (TRAX_USES_WIDE_BVH): the host builds the
+/// binary BVH, collapses it to 4 or 8 children per node (render --accel bvh4|bvh8) and lays out
+/// only the wide nodes (AccelRecord kind kAccelWideBvh).
+constexpr const char* kUsesWideBvhSymbol = "trax_uses_wide_bvh";
 /// Name of the marker symbol trax.hpp's emitter and random-number functions leave in a kernel's
 /// ELF: the host adds the SceneExtras sections only for such kernels, so the memory image (and
 /// every statistic) of a kernel that reads neither stays as it was before they existed.
@@ -115,10 +119,40 @@ constexpr int32_t kMaxLeafTriangles = 8;
 /// overflows: the host builds with scene::BvhConfig::traversal_stack_entries set to it.
 constexpr int32_t kTraversalStackEntries = 32;
 
+/// Entries in the wide-BVH traversal stack (kernel/wide_bvh.hpp). It pushes every child a ray
+/// hits but the nearest; the host refuses a wide BVH in which some path could need more
+/// (scene::WideBvhStats::worst_stack).
+constexpr int32_t kWideStackEntries = 64;
+
 /// Which acceleration structure an AccelRecord describes.
 enum AccelKind : int32_t {
     kAccelGrid = 1,
+    kAccelWideBvh = 2,
 };
+
+/// A wide-BVH child reference, the same in both box formats: 0 is no child (a node's children
+/// come first, its empty slots last); > 0 is the word address of an interior child's node; < 0
+/// is a leaf holding triangles [first, first + count) of the triangles section, encoded as
+/// kWideLeafBit | first << 4 | count (count 1..kMaxLeafTriangles, first < 2^27).
+constexpr uint32_t kWideLeafBit = 0x8000'0000u;
+constexpr int32_t kWideMaxLeafFirst = (1 << 27) - 1;
+/// Words of one wide node: every node starts on a 64-byte line.
+///   Float boxes: words [6c, 6c + 6) hold child c's box (min xyz, max xyz), word 6 * width + c
+///   its reference; 8 * width words (padding to the line).
+///   Quantized boxes (Ylitie et al. 2017): words 0..2 the node's box origin o (floats); word 3
+///   the biased exponents e_x | e_y << 8 | e_z << 16 (scale s_a = 2^(e_a - 127), the float with
+///   bits e_a << 23); words [4, 4 + width) the references; then six byte vectors of `width`
+///   bytes, lo_x, lo_y, lo_z, hi_x, hi_y, hi_z: child c's box on axis a is
+///   [o_a + lo_a[c] * s_a, o_a + hi_a[c] * s_a], computed in float (the product is exact), and
+///   contains the child's float box; 4 * width words.
+constexpr int32_t wide_node_words(int32_t width, bool quantized) {
+    return quantized ? 4 * width : 8 * width;
+}
+/// Quantized nodes: the word of the first reference, and the byte offset of the byte vectors.
+constexpr int32_t kWideQuantizedRefs = 4;
+constexpr int32_t wide_quantized_boxes_byte(int32_t width) {
+    return (kWideQuantizedRefs + width) * 4;
+}
 
 /// The acceleration structure other than the binary BVH (which has its own header section),
 /// one record the header's `accel` word points to.
@@ -129,6 +163,10 @@ enum AccelKind : int32_t {
 /// number x + resolution[0] * (y + resolution[1] * z). `nodes` holds one word per cell plus one:
 /// cell i's triangles are refs[nodes[i] .. nodes[i + 1]), image triangle indices, every triangle
 /// listed in every cell its bounding box overlaps (so a triangle may appear in many cells).
+///
+/// Wide BVH (kAccelWideBvh): `width` (4 or 8) children per node, boxes quantized or not; the
+/// bounds are the root's box; `nodes` holds the nodes (count in words, the root first, each
+/// wide_node_words long); refs, scale and resolution are unused.
 struct AccelRecord {
     int32_t kind;  ///< AccelKind
     SectionRef nodes;
@@ -137,6 +175,8 @@ struct AccelRecord {
     float bounds_max[3];
     float scale[3];
     int32_t resolution[3];
+    int32_t width;
+    int32_t quantized;  ///< 1: quantized child boxes, 0: float
 };
 
 /// The first words of global memory.
@@ -281,6 +321,8 @@ enum RecordWord : int32_t {
     kAccelBoundsMax = 8,
     kAccelScale = 11,
     kAccelResolution = 14,
+    kAccelWidth = 17,
+    kAccelQuantized = 18,
     kStatsPrimaryRays = 0,
     kStatsShadowRays = 1,
     kStatsNodesVisited = 2,
@@ -331,6 +373,8 @@ TRAX_LAYOUT_WORD(AccelRecord, bounds_min, kAccelBoundsMin);
 TRAX_LAYOUT_WORD(AccelRecord, bounds_max, kAccelBoundsMax);
 TRAX_LAYOUT_WORD(AccelRecord, scale, kAccelScale);
 TRAX_LAYOUT_WORD(AccelRecord, resolution, kAccelResolution);
+TRAX_LAYOUT_WORD(AccelRecord, width, kAccelWidth);
+TRAX_LAYOUT_WORD(AccelRecord, quantized, kAccelQuantized);
 TRAX_LAYOUT_WORD(ThreadStats, primary_rays, kStatsPrimaryRays);
 TRAX_LAYOUT_WORD(ThreadStats, shadow_rays, kStatsShadowRays);
 TRAX_LAYOUT_WORD(ThreadStats, nodes_visited_lo, kStatsNodesVisited);
@@ -386,7 +430,9 @@ static_assert(sizeof(BvhNode) == 32, "the BVH node is one half cache line");
 /// 32 words: one cache line pair, and the sections still start at word 32 as they did when the
 /// header was 31 words.
 static_assert(sizeof(SceneHeader) == 128);
-static_assert(sizeof(AccelRecord) == 68);
+static_assert(sizeof(AccelRecord) == 76);
+static_assert(wide_quantized_boxes_byte(4) + 6 * 4 <= 4 * wide_node_words(4, true) &&
+              wide_quantized_boxes_byte(8) + 6 * 8 <= 4 * wide_node_words(8, true));
 static_assert(sizeof(ThreadStats) == 32 && sizeof(Ray) == 44 && sizeof(RayResult) == 32);
 
 /// Rounds a word address up to the section alignment.

@@ -45,6 +45,17 @@ TRAX_INLINE int loadi(int addr, int offset = 0) {
     return value;
 }
 
+/// The byte at byte offset `byte` (0..) from word address `addr`, zero-extended: one lbu, for
+/// packed records such as the quantized wide-BVH node (scene_layout.hpp). Bytes are little-endian
+/// within a word.
+TRAX_INLINE uint32_t loadbyte(int addr, int byte) {
+    uint32_t value;
+    const uint8_t* p =
+        reinterpret_cast<const uint8_t*>(trax::detail::global_word<const uint32_t>(addr, 0)) + byte;
+    asm("lbu %0, %1" : "=r"(value) : "m"(*p));
+    return value;
+}
+
 TRAX_INLINE void storef(float value, int addr, int offset = 0) {
     float* p = trax::detail::global_word<float>(addr, offset);
     asm volatile("fsw %1, %0" : "=m"(*p) : "f"(value));
@@ -118,6 +129,15 @@ TRAX_CSR_FUNCTION(trax_tm_size, 0xCC4)
         ".globl trax_uses_grid\n.type trax_uses_grid, @function\n"                                 \
         "trax_uses_grid:\n  ret\n.size trax_uses_grid, . - trax_uses_grid\n.popsection")
 
+/// Write `TRAX_USES_WIDE_BVH;` at file scope in a kernel that traverses a wide BVH (kernel/
+/// wide_bvh.hpp): tpsim then builds the 4- or 8-wide BVH that render --accel names
+/// (trax::layout::kUsesWideBvhSymbol).
+#define TRAX_USES_WIDE_BVH                                                                         \
+    asm(".pushsection .text.trax_uses_wide_bvh, \"ax\", @progbits\n"                               \
+        ".globl trax_uses_wide_bvh\n.type trax_uses_wide_bvh, @function\n"                         \
+        "trax_uses_wide_bvh:\n  ret\n.size trax_uses_wide_bvh, . - "                               \
+        "trax_uses_wide_bvh\n.popsection")
+
 namespace trax::detail {
 /// Leaves the marker trax::layout::kUsesExtrasSymbol in the ELF (once per object file: .ifndef;
 /// weak, so objects may share it; kept by the link script). Called by every function that reads
@@ -151,6 +171,7 @@ TRAX_INLINE void set_rand_state(uint32_t state) {
 /// The twin is told about the BVH or grid by the host, which reads the marker from the ELF.
 #define TRAX_USES_BVH static_assert(true)
 #define TRAX_USES_GRID static_assert(true)
+#define TRAX_USES_WIDE_BVH static_assert(true)
 
 namespace trax::native {
 
@@ -211,6 +232,9 @@ inline float loadf(int addr, int offset = 0) {
 }
 inline int loadi(int addr, int offset = 0) {
     return static_cast<int>(trax::native::word("loadi", addr, offset));
+}
+inline uint32_t loadbyte(int addr, int byte) {
+    return trax::native::word("loadbyte", addr, byte >> 2) >> ((byte & 3) * 8) & 255u;
 }
 inline void storef(float value, int addr, int offset = 0) {
     trax::native::writable_word("storef", addr, offset) = __builtin_bit_cast(uint32_t, value);

@@ -221,7 +221,7 @@ std::vector<SetupDifference> setup_differences(const std::vector<StatsFile>& run
     };
     for (const char* field :
          {"scene", "kernel", "engine", "accel", "grid_resolution", "grid_density", "bvh_builder",
-          "max_leaf", "bvh_order", "bvh_align_pairs"}) {
+          "max_leaf", "bvh_order", "bvh_align_pairs", "bvh_boxes"}) {
         std::vector<std::string> values;
         for (const StatsFile& run : runs)
             values.push_back(run_field(run, field));

@@ -188,6 +188,10 @@ std::string run_line(const StatsFile& run) {
                               field("grid_resolution")));
     else if (accel == "none")
         parts.push_back("no acceleration structure");
+    else if (accel == "bvh4" || accel == "bvh8")
+        parts.push_back(fmt::format("{}-wide BVH from {}, max_leaf {}, nodes {}, {} boxes",
+                                    accel.substr(3), field("bvh_builder"), field("max_leaf"),
+                                    field("bvh_order"), field("bvh_boxes")));
     else if (!field("bvh_builder").empty())
         parts.push_back(fmt::format(
             "BVH {}, max_leaf {}{}{}", field("bvh_builder"), field("max_leaf"),

@@ -43,6 +43,7 @@ struct RenderCommandOptions {
     uint32_t max_leaf = 8;
     std::string bvh_order = scene::to_string(scene::BvhConfig{}.order);
     bool bvh_align_pairs = false;
+    std::string bvh_boxes = scene::to_string(scene::BvhConfig{}.boxes);
     bool native = false;
     bool no_fork = false;
     std::string timing = "cycle";
@@ -109,12 +110,11 @@ int run_render(RenderCommandOptions& o) {
     options.timeline_interval = o.timeline_cycles;
     if (!o.config.empty()) options.chip = timing::load_config(o.config);
     timing::apply_overrides(options.chip, o.overrides);
-    options.bvh.builder = o.bvh == "binned"   ? scene::BvhBuilder::binned
-                          : o.bvh == "median" ? scene::BvhBuilder::median
-                                              : scene::BvhBuilder::sweep;
+    options.bvh.builder = *scene::find_bvh_builder(o.bvh);
     options.bvh.max_leaf_size = o.max_leaf;
     options.bvh.order = *scene::find_bvh_order(o.bvh_order);
     options.bvh.align_pairs = o.bvh_align_pairs;
+    options.bvh.boxes = *scene::find_bvh_boxes(o.bvh_boxes);
 
     // Bad output paths are found now, not after a render that may take hours.
     const std::filesystem::path output =
@@ -227,9 +227,10 @@ Command add_render_command(CLI::App& app) {
                         "tracer of --accel]");
     command
         ->add_option("--accel", o->accel,
-                     "Acceleration structure: bvh2 (binary BVH, kernel tracer) or grid (uniform "
-                     "grid, kernel tracer_grid); with --kernel, the one the kernel traverses "
-                     "(docs/accel.md) [default: the kernel's]")
+                     "Acceleration structure: bvh2 (binary BVH, kernel tracer), bvh4 or bvh8 "
+                     "(wide BVHs, kernel tracer_wide) or grid (uniform grid, kernel "
+                     "tracer_grid); with --kernel, one the kernel traverses (docs/accel.md) "
+                     "[default: the kernel's]")
         ->check(CLI::IsMember(scene::accel_names()));
     command
         ->add_option("--grid-resolution", o->grid_resolution,
@@ -260,7 +261,7 @@ Command add_render_command(CLI::App& app) {
     command
         ->add_option("--bvh", o->bvh,
                      "BVH builder, used when the kernel traverses a BVH (TRAX_USES_BVH)")
-        ->check(CLI::IsMember({"sweep", "binned", "median"}))
+        ->check(CLI::IsMember(scene::bvh_builder_names()))
         ->capture_default_str();
     command->add_option("--max-leaf", o->max_leaf, "Most triangles in one BVH leaf")
         ->check(CLI::Range(1, 8))
@@ -272,7 +273,14 @@ Command add_render_command(CLI::App& app) {
         ->check(CLI::IsMember(scene::bvh_order_names()))
         ->capture_default_str();
     command->add_flag("--bvh-align-pairs", o->bvh_align_pairs,
-                      "Start every BVH sibling pair on a 64-byte line (docs/accel.md)");
+                      "Start every BVH sibling pair on a 64-byte line (docs/accel.md); wide "
+                      "BVH nodes always start on one");
+    command
+        ->add_option("--bvh-boxes", o->bvh_boxes,
+                     "How a wide BVH (--accel bvh4|bvh8) stores its child boxes: float, or "
+                     "quantized to 8 bits per bound (docs/accel.md)")
+        ->check(CLI::IsMember(scene::bvh_boxes_names()))
+        ->capture_default_str();
     // The same limits as the scene file's [image] keys (docs/scenes.md).
     command->add_option("--width", o->width, "Image width in pixels, instead of the scene's")
         ->check(whole_number_in(1, 16384));

@@ -45,40 +45,35 @@ void write(std::vector<uint32_t>& words, int32_t addr, const Record& record) {
     std::memcpy(words.data() + addr, &record, sizeof(Record));
 }
 
-/// The builder's interior nodes (each the parent of one sibling pair) in the order their pairs
-/// are laid out (scene::BvhOrder). Builder nodes are depth-first: the left child of interior
-/// node p is p + 1, the right one is at right_child.
-std::vector<uint32_t> pair_order(const scene::Bvh& bvh, scene::BvhOrder order) {
-    const auto interior = [&](uint32_t n) { return !bvh.nodes[n].is_leaf(); };
-    const auto children = [&](uint32_t p) {
-        return std::array<uint32_t, 2>{p + 1, bvh.nodes[p].right_child};
-    };
+/// The nodes of a tree in the order `order` lays them out: `children(p)` lists node p's
+/// interior children, left to right; the root is 0 and every child's index is larger than its
+/// parent's.
+template <class Children>
+std::vector<uint32_t> tree_order(size_t nodes, Children children, scene::BvhOrder order) {
     std::vector<uint32_t> out;
-    if (!interior(0)) return out;
-    out.reserve(bvh.nodes.size() / 2);
+    out.reserve(nodes);
     if (order == scene::BvhOrder::breadth_first) {
         out.push_back(0);
         for (size_t i = 0; i < out.size(); ++i)
             for (uint32_t c : children(out[i]))
-                if (interior(c)) out.push_back(c);
+                out.push_back(c);
     } else if (order == scene::BvhOrder::depth_first) {
         std::vector<uint32_t> stack{0};
         while (!stack.empty()) {
             const uint32_t p = stack.back();
             stack.pop_back();
             out.push_back(p);
-            const auto [left, right] = children(p);
-            if (interior(right)) stack.push_back(right);
-            if (interior(left)) stack.push_back(left);
+            const auto below = children(p);
+            stack.insert(stack.end(), below.rbegin(), below.rend());
         }
     } else {
-        // Height of each pair's subtree in the tree of pairs, children before parents: a
-        // child's builder index is larger than its parent's.
-        std::vector<uint32_t> height(bvh.nodes.size(), 0);
-        for (size_t n = bvh.nodes.size(); n-- > 0;)
-            if (interior(uint32_t(n)))
-                for (uint32_t c : children(uint32_t(n)))
-                    height[n] = std::max(height[n], interior(c) ? height[c] + 1 : 1);
+        // Height of each node's subtree, children before parents.
+        std::vector<uint32_t> height(nodes, 0);
+        for (size_t n = nodes; n-- > 0;) {
+            height[n] = 1;
+            for (uint32_t c : children(uint32_t(n)))
+                height[n] = std::max(height[n], height[c] + 1);
+        }
         // Lays out the top `levels` levels of p's subtree: the top half, then each subtree
         // hanging below it, left to right.
         const auto lay_out = [&](const auto& self, uint32_t p, uint32_t levels) -> void {
@@ -93,7 +88,7 @@ std::vector<uint32_t> pair_order(const scene::Bvh& bvh, scene::BvhOrder order) {
                 std::vector<uint32_t> next;
                 for (uint32_t q : frontier)
                     for (uint32_t c : children(q))
-                        if (interior(c)) next.push_back(c);
+                        next.push_back(c);
                 frontier.swap(next);
             }
             for (uint32_t q : frontier)
@@ -102,6 +97,58 @@ std::vector<uint32_t> pair_order(const scene::Bvh& bvh, scene::BvhOrder order) {
         lay_out(lay_out, 0, height[0]);
     }
     return out;
+}
+
+/// The builder's interior nodes (each the parent of one sibling pair) in the order their pairs
+/// are laid out (scene::BvhOrder): the tree of pairs is the tree of interior nodes. Builder
+/// nodes are depth-first: the left child of interior node p is p + 1, the right one is at
+/// right_child.
+std::vector<uint32_t> pair_order(const scene::Bvh& bvh, scene::BvhOrder order) {
+    if (bvh.nodes[0].is_leaf()) return {};
+    // Interior nodes are numbered densely for tree_order, keeping the builder's order.
+    std::vector<uint32_t> dense(bvh.nodes.size(), 0), interior;
+    for (uint32_t n = 0; n < bvh.nodes.size(); ++n)
+        if (!bvh.nodes[n].is_leaf()) {
+            dense[n] = uint32_t(interior.size());
+            interior.push_back(n);
+        }
+    const auto children = [&](uint32_t d) {
+        const uint32_t p = interior[d];
+        std::vector<uint32_t> out;
+        for (uint32_t c : {p + 1, bvh.nodes[p].right_child})
+            if (!bvh.nodes[c].is_leaf()) out.push_back(dense[c]);
+        return out;
+    };
+    std::vector<uint32_t> pairs = tree_order(interior.size(), children, order);
+    for (uint32_t& p : pairs)
+        p = interior[p];
+    return pairs;
+}
+
+/// The exponent e of the smallest power of two with 255 * 2^e >= extent, at least -126 so that
+/// the scale is a normal float; biased by 127, as the kernel rebuilds the scale from it.
+uint32_t quantization_exponent(float lo, float hi) {
+    const double extent = double(hi) - double(lo);  // exact
+    int e = -126;
+    while (std::ldexp(255.0, e) < extent)
+        ++e;
+    return uint32_t(e + 127);
+}
+
+/// The 8-bit offsets of [lo, hi] on the grid origin + q * scale (origin <= lo, hi <= origin +
+/// 255 * scale), rounded outwards, so that the box the kernel decodes, fl(origin + q * scale)
+/// (q * scale is exact), contains [lo, hi]. Where lo - origin is exact in double, the floor and
+/// ceiling already ensure it, rounding being monotone and the bounds floats; the loops fix the
+/// rest: bounds that far apart (-2^56 and -1e-20) round their difference, perhaps up.
+std::array<uint32_t, 2> quantize(float lo, float hi, float origin, float scale) {
+    const auto decode = [&](uint32_t q) { return origin + float(q) * scale; };
+    auto q_lo = uint32_t(std::clamp(std::floor((double(lo) - origin) / scale), 0.0, 255.0));
+    while (q_lo > 0 && decode(q_lo) > lo)
+        --q_lo;
+    auto q_hi = uint32_t(std::clamp(std::ceil((double(hi) - origin) / scale), 0.0, 255.0));
+    while (q_hi < 255 && decode(q_hi) < hi)
+        ++q_hi;
+    return {q_lo, q_hi};
 }
 
 /// The emissive triangles of the image (in image order), each picked with probability
@@ -162,6 +209,71 @@ std::vector<layout::BvhNode> compile_bvh(const scene::Bvh& bvh, scene::BvhOrder 
     return out;
 }
 
+std::vector<uint32_t> compile_wide_bvh(const scene::WideBvh& bvh, scene::BvhOrder order,
+                                       scene::BvhBoxes boxes, int32_t addr) {
+    const auto width = int32_t(bvh.stats.width);
+    const bool quantized = boxes == scene::BvhBoxes::quantized;
+    const int32_t node_words = layout::wide_node_words(width, quantized);
+    const auto children = [&](uint32_t n) {
+        std::vector<uint32_t> out;
+        const scene::WideNode& node = bvh.nodes[n];
+        for (uint32_t c = 0; c < node.child_count; ++c)
+            if (!node.children[c].is_leaf()) out.push_back(node.children[c].node);
+        return out;
+    };
+    const std::vector<uint32_t> placed = tree_order(bvh.nodes.size(), children, order);
+    std::vector<int32_t> node_addr(bvh.nodes.size(), 0);
+    for (size_t j = 0; j < placed.size(); ++j)
+        node_addr[placed[j]] = addr + int32_t(j) * node_words;
+    std::vector<uint32_t> words(placed.size() * size_t(node_words), 0u);
+    const auto reference = [&](const scene::WideChild& child) {
+        if (!child.is_leaf()) return uint32_t(node_addr[child.node]);
+        if (child.first_triangle > uint32_t(layout::kWideMaxLeafFirst))
+            throw Error(fmt::format("wide BVH: a leaf starts at triangle {}; the node format "
+                                    "addresses at most {} triangles",
+                                    child.first_triangle, layout::kWideMaxLeafFirst));
+        return layout::kWideLeafBit | child.first_triangle << 4 | child.triangle_count;
+    };
+    for (size_t n = 0; n < bvh.nodes.size(); ++n) {
+        const scene::WideNode& node = bvh.nodes[n];
+        uint32_t* out = words.data() + (node_addr[n] - addr);
+        if (!quantized) {
+            for (uint32_t c = 0; c < node.child_count; ++c) {
+                const scene::WideChild& child = node.children[c];
+                for (int a = 0; a < 3; ++a) {
+                    std::memcpy(out + 6 * c + a, &child.bounds.lo[a], 4);
+                    std::memcpy(out + 6 * c + 3 + a, &child.bounds.hi[a], 4);
+                }
+                out[6 * width + int32_t(c)] = reference(child);
+            }
+            continue;
+        }
+        glm::vec3 lo = node.children[0].bounds.lo, hi = node.children[0].bounds.hi;
+        for (uint32_t c = 1; c < node.child_count; ++c) {
+            lo = glm::min(lo, node.children[c].bounds.lo);
+            hi = glm::max(hi, node.children[c].bounds.hi);
+        }
+        auto* bytes = reinterpret_cast<uint8_t*>(out) + layout::wide_quantized_boxes_byte(width);
+        for (int a = 0; a < 3; ++a) {
+            std::memcpy(out + a, &lo[a], 4);
+            const uint32_t exponent = quantization_exponent(lo[a], hi[a]);
+            out[3] |= exponent << (8 * a);
+            float scale;
+            const uint32_t scale_bits = exponent << 23;
+            std::memcpy(&scale, &scale_bits, 4);
+            for (uint32_t c = 0; c < node.child_count; ++c) {
+                const scene::Aabb& box = node.children[c].bounds;
+                const auto [q_lo, q_hi] = quantize(box.lo[a], box.hi[a], lo[a], scale);
+                bytes[a * width + int32_t(c)] = uint8_t(q_lo);
+                bytes[(3 + a) * width + int32_t(c)] = uint8_t(q_hi);
+            }
+        }
+        for (uint32_t c = 0; c < node.child_count; ++c)
+            out[layout::kWideQuantizedRefs + int32_t(c)] = reference(node.children[c]);
+    }
+    return words;
+}
+
 MemoryImage build_memory_image(const scene::Scene& scene, Accel accel, uint32_t threads,
                                std::span<const layout::Ray> rays,
                                std::optional<uint32_t> extras_seed) {
@@ -169,7 +281,11 @@ MemoryImage build_memory_image(const scene::Scene& scene, Accel accel, uint32_t 
         throw Error("scene has an empty image (width or height is 0)");
     if (scene.triangles.empty()) throw Error("scene has no triangles");
     const scene::Bvh* bvh = accel.bvh;
+    const scene::WideBvh* wide = accel.wide_bvh;
     const scene::Grid* grid = accel.grid;
+    const std::vector<uint32_t>* triangle_order = bvh    ? &bvh->triangle_order
+                                                  : wide ? &wide->triangle_order
+                                                         : nullptr;
 
     layout::SceneHeader h{};
     h.magic = layout::kMagic;
@@ -210,6 +326,18 @@ MemoryImage build_memory_image(const scene::Scene& scene, Accel accel, uint32_t 
         for (int a = 0; a < 3; ++a)
             accel_record.resolution[a] = int32_t(grid->stats.resolution[size_t(a)]);
     }
+    const bool quantized = accel.bvh_boxes == scene::BvhBoxes::quantized;
+    if (wide != nullptr) {
+        accel_record.kind = layout::kAccelWideBvh;
+        accel_record.width = int32_t(wide->stats.width);
+        accel_record.quantized = quantized ? 1 : 0;
+        accel_record.nodes.count = checked_count(
+            wide->nodes.size() * size_t(layout::wide_node_words(accel_record.width, quantized)),
+            "wide BVH node words");
+        put(accel_record.bounds_min, wide->bounds.lo);
+        put(accel_record.bounds_max, wide->bounds.hi);
+    }
+    const bool has_record = grid != nullptr || wide != nullptr;
     const uint64_t pixels = uint64_t(scene.width) * scene.height;
     if (pixels > uint64_t(std::numeric_limits<int32_t>::max() / 16))
         throw Error(fmt::format("image {}x{} is too large for the 32-bit memory image", scene.width,
@@ -235,7 +363,7 @@ MemoryImage build_memory_image(const scene::Scene& scene, Accel accel, uint32_t 
     std::vector<layout::Triangle> triangles;
     triangles.reserve(scene.triangles.size());
     for (size_t i = 0; i < scene.triangles.size(); ++i) {
-        const scene::Triangle& t = scene.triangles[bvh ? bvh->triangle_order[i] : i];
+        const scene::Triangle& t = scene.triangles[triangle_order ? (*triangle_order)[i] : i];
         if (t.material >= scene.materials.size())
             throw Error(fmt::format("triangle {} uses material {} but the scene has {}", i,
                                     t.material, scene.materials.size()));
@@ -253,7 +381,8 @@ MemoryImage build_memory_image(const scene::Scene& scene, Accel accel, uint32_t 
         emitters = compile_emitters(triangles, scene.materials);
         extras.emitters.count = checked_count(emitters.size(), "emitters");
     }
-    layout::place_sections(h, extras_seed ? &extras : nullptr, grid ? &accel_record : nullptr);
+    layout::place_sections(h, extras_seed ? &extras : nullptr,
+                           has_record ? &accel_record : nullptr);
 
     MemoryImage image;
     image.words.assign(size_t(h.total_words), 0u);
@@ -293,6 +422,12 @@ MemoryImage build_memory_image(const scene::Scene& scene, Accel accel, uint32_t 
         std::memcpy(image.words.data() + accel_record.refs.addr, grid->references.data(),
                     grid->references.size() * 4);
     }
+    if (wide != nullptr) {
+        write(image.words, h.accel, accel_record);
+        const std::vector<uint32_t> nodes =
+            compile_wide_bvh(*wide, accel.bvh_order, accel.bvh_boxes, accel_record.nodes.addr);
+        std::memcpy(image.words.data() + accel_record.nodes.addr, nodes.data(), nodes.size() * 4);
+    }
     for (size_t i = 0; i < rays.size(); ++i)
         write(image.words, h.rays.addr + int32_t(i) * layout::kRayWords, rays[i]);
 
@@ -314,7 +449,14 @@ MemoryImage build_memory_image(const scene::Scene& scene, Accel accel, uint32_t 
     image.sections.push_back(section("triangles", h.triangles, layout::kTriangleWords));
     if (extras_seed)
         image.sections.push_back(section("emitters", extras.emitters, layout::kEmitterWords));
-    image.sections.push_back(section("bvh_nodes", h.bvh_nodes, layout::kBvhNodeWords));
+    if (wide != nullptr) {
+        image.sections.push_back({"bvh_root", 1, sizeof(accel_record), uint64_t(h.accel) * 4});
+        image.sections.push_back({"bvh_nodes", uint32_t(wide->nodes.size()),
+                                  uint64_t(accel_record.nodes.count) * 4,
+                                  uint64_t(accel_record.nodes.addr) * 4});
+    } else {
+        image.sections.push_back(section("bvh_nodes", h.bvh_nodes, layout::kBvhNodeWords));
+    }
     // The structure's sections only when it is there, named after it.
     if (grid != nullptr) {
         image.sections.push_back({"grid", 1, sizeof(accel_record), uint64_t(h.accel) * 4});

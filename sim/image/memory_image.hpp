@@ -11,6 +11,7 @@
 #include "sim/scene/bvh.hpp"
 #include "sim/scene/grid.hpp"
 #include "sim/scene/scene.hpp"
+#include "sim/scene/wide_bvh.hpp"
 
 namespace tpsim::image {
 
@@ -39,13 +40,17 @@ struct MemoryImage {
 /// traverses (or none, for brute force).
 struct Accel {
     const scene::Bvh* bvh = nullptr;
+    const scene::WideBvh* wide_bvh = nullptr;
     scene::BvhOrder bvh_order = scene::BvhOrder::breadth_first;  ///< scene::BvhConfig::order
     bool bvh_align_pairs = false;                                ///< scene::BvhConfig::align_pairs
+    scene::BvhBoxes bvh_boxes = scene::BvhBoxes::floats;         ///< scene::BvhConfig::boxes
     const scene::Grid* grid = nullptr;
     Accel(std::nullptr_t = nullptr) {}
     Accel(const scene::Bvh* b, scene::BvhOrder order = scene::BvhOrder::breadth_first,
           bool align_pairs = false)
         : bvh(b), bvh_order(order), bvh_align_pairs(align_pairs) {}
+    Accel(const scene::WideBvh* b, scene::BvhOrder order, scene::BvhBoxes boxes)
+        : wide_bvh(b), bvh_order(order), bvh_boxes(boxes) {}
     Accel(const scene::Grid* g) : grid(g) {}
 };
 
@@ -56,10 +61,18 @@ struct Accel {
 std::vector<trax::layout::BvhNode> compile_bvh(const scene::Bvh& bvh, scene::BvhOrder order,
                                                bool align_pairs);
 
+/// The wide BVH's nodes (layout::wide_node_words each) in `order`, for a section at word
+/// address `addr`: child references are word addresses. Throws tpsim::Error for a leaf the
+/// reference format cannot address.
+std::vector<uint32_t> compile_wide_bvh(const scene::WideBvh& bvh, scene::BvhOrder order,
+                                       scene::BvhBoxes boxes, int32_t addr);
+
 /// Lays the scene out. With a BVH, triangles are stored in leaf order and nodes with sibling
 /// pairs adjacent, as the traversal kernel expects; without one, the BVH section is left out.
 /// With a grid, the AccelRecord and the grid's cells and references (sections "grid",
-/// "grid_cells", "grid_refs"), triangles in scene order.
+/// "grid_cells", "grid_refs"), triangles in scene order. With a wide BVH, the AccelRecord
+/// ("bvh_root") and the wide nodes ("bvh_nodes", the binary BVH's region name, so that traffic
+/// compares across widths), triangles in leaf order.
 /// One zeroed ThreadStats record per thread (`threads` of them); `rays` (for the ray_query
 /// kernel) and room for as many RayResults. With `extras_seed`, also the SceneExtras record
 /// (that run seed, every material's emission, the emissive triangles): only for kernels that

@@ -87,16 +87,22 @@ std::string Kernel::stale_warning() const {
 }
 
 scene::AccelStructure Kernel::accel() const {
-    const bool bvh = defines(trax::layout::kUsesBvhSymbol);
-    const bool grid = defines(trax::layout::kUsesGridSymbol);
-    if (bvh && grid)
-        throw Error(fmt::format("kernel '{}' declares both TRAX_USES_BVH and TRAX_USES_GRID; a "
-                                "kernel traverses one structure: keep the marker of the one it "
-                                "reads",
-                                elf.filename().string()));
-    return bvh    ? scene::AccelStructure::bvh2
-           : grid ? scene::AccelStructure::grid
-                  : scene::AccelStructure::none;
+    std::optional<scene::AccelInfo> found;
+    for (const scene::AccelInfo& info : scene::kAccelStructures) {
+        if (!defines(info.marker)) continue;
+        if (found && found->marker != info.marker)
+            throw Error(fmt::format("kernel '{}' declares that it traverses both {} and {}; a "
+                                    "kernel traverses one structure: keep the marker of the one "
+                                    "it reads",
+                                    elf.filename().string(), found->description, info.description));
+        if (!found) found = info;
+    }
+    return found ? found->structure : scene::AccelStructure::none;
+}
+
+bool Kernel::traverses(scene::AccelStructure structure) const {
+    const std::string_view marker = scene::accel_info(structure).marker;
+    return marker.empty() ? accel() == scene::AccelStructure::none : defines(marker);
 }
 
 bool Kernel::uses_extras() const {
@@ -170,22 +176,41 @@ RenderResult render(const RenderOptions& options) {
         !warning.empty() && options.on_warning)
         options.on_warning(warning);
     result.accel = kernel.accel();
-    if (options.accel && *options.accel != result.accel)
+    if (options.accel && !kernel.traverses(*options.accel))
         throw Error(fmt::format(
             "--accel {} asks for {} but kernel '{}' traverses {}; give a kernel that traverses "
             "it (e.g. --kernel {}) or leave --accel out",
             scene::to_string(*options.accel), scene::accel_info(*options.accel).description,
             kernel.elf.filename().string(), scene::accel_info(result.accel).description,
             scene::accel_info(*options.accel).default_kernel));
+    if (options.accel) result.accel = *options.accel;
+    const uint32_t width = scene::wide_bvh_width(result.accel);
+    if (options.bvh.boxes == scene::BvhBoxes::quantized && width == 0)
+        throw Error(fmt::format("--bvh-boxes quantized applies to the wide BVHs (--accel bvh4 or "
+                                "bvh8), not to {}; leave it out or pick a wide BVH",
+                                scene::accel_info(result.accel).description));
     std::optional<scene::Bvh> bvh;
+    std::optional<scene::WideBvh> wide_bvh;
     std::optional<scene::Grid> grid;
-    if (result.accel == scene::AccelStructure::bvh2) {
+    if (result.accel == scene::AccelStructure::bvh2 || width != 0) {
         start = std::chrono::steady_clock::now();
         scene::BvhConfig config = options.bvh;
         config.traversal_stack_entries = trax::layout::kTraversalStackEntries;
         bvh = scene::build_bvh(result.scene.triangles, config);
         result.bvh_seconds = seconds_since(start);
         result.bvh = bvh->stats;
+        if (width != 0) {
+            wide_bvh = scene::collapse_bvh(*bvh, width);
+            bvh.reset();
+            result.wide_bvh = wide_bvh->stats;
+            if (wide_bvh->stats.worst_stack > uint32_t(trax::layout::kWideStackEntries))
+                throw Error(fmt::format(
+                    "the {} may need {} traversal-stack entries on one path but the kernels' "
+                    "stack holds {} (trax::layout::kWideStackEntries); use a narrower BVH "
+                    "(--accel bvh4 or bvh2) or a larger stack",
+                    scene::accel_info(result.accel).description, wide_bvh->stats.worst_stack,
+                    trax::layout::kWideStackEntries));
+        }
     } else if (result.accel == scene::AccelStructure::grid) {
         start = std::chrono::steady_clock::now();
         try {
@@ -198,6 +223,8 @@ RenderResult render(const RenderOptions& options) {
     }
     result.threads = options.chip.chip.num_tms * options.chip.chip.tps_per_tm;
     const image::Accel accel = bvh ? image::Accel(&*bvh, options.bvh.order, options.bvh.align_pairs)
+                               : wide_bvh
+                                   ? image::Accel(&*wide_bvh, options.bvh.order, options.bvh.boxes)
                                : grid ? image::Accel(&*grid)
                                       : nullptr;
     result.image = image::build_memory_image(result.scene, accel, result.threads, {},

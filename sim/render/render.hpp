@@ -65,6 +65,9 @@ struct Kernel {
     /// kUsesBvhSymbol, kUsesGridSymbol); none for brute force. Throws tpsim::Error for a kernel
     /// that defines more than one.
     scene::AccelStructure accel() const;
+    /// Can the kernel traverse `structure` (does it define the structure's marker; for none:
+    /// no marker at all)? bvh4 and bvh8 share one.
+    bool traverses(scene::AccelStructure structure) const;
     /// Does the kernel read the SceneExtras record (define trax::layout::kUsesExtrasSymbol)?
     bool uses_extras() const;
     /// Does the ELF define a function (or code label) of this name?
@@ -92,7 +95,7 @@ struct RenderOptions {
     /// The grid to build when the kernel traverses one (TRAX_USES_GRID).
     scene::GridConfig grid;
     /// The structure the user asked for (render --accel): render() refuses a kernel that
-    /// traverses another. Unset: whichever the kernel traverses.
+    /// traverses another. Unset: whichever the kernel traverses (bvh4 for a wide-BVH kernel).
     std::optional<scene::AccelStructure> accel;
     /// Override the scene file's image size and samples per pixel when non-zero
     /// (render --width/--height/--spp; tests render small images).
@@ -133,14 +136,16 @@ struct KernelRun {
 struct RenderResult {
     scene::Scene scene;                                         ///< as loaded (triangles included)
     scene::AccelStructure accel = scene::AccelStructure::none;  ///< what the kernel traverses
-    std::optional<scene::BvhStats> bvh;                         ///< when a BVH was built
-    std::optional<scene::GridStats> grid;                       ///< when a grid was built
-    image::MemoryImage image;                                   ///< the memory image after the run
-    image::TraversalTotals traversal;  ///< the kernel's per-thread statistics, summed
-    std::vector<float> rgb;            ///< framebuffer, linear RGB, row 0 at the top
-    InstructionCounts instructions;    ///< zero for the native engine
-    trax::KernelOutput output;         ///< what the kernel printed (trax_printf)
-    std::vector<KernelParam> params;   ///< the kernel's parameters as the run set them
+    /// When a BVH was built (for a wide BVH, the binary tree it was collapsed from).
+    std::optional<scene::BvhStats> bvh;
+    std::optional<scene::WideBvhStats> wide_bvh;  ///< when a wide BVH was built
+    std::optional<scene::GridStats> grid;         ///< when a grid was built
+    image::MemoryImage image;                     ///< the memory image after the run
+    image::TraversalTotals traversal;             ///< the kernel's per-thread statistics, summed
+    std::vector<float> rgb;                       ///< framebuffer, linear RGB, row 0 at the top
+    InstructionCounts instructions;               ///< zero for the native engine
+    trax::KernelOutput output;                    ///< what the kernel printed (trax_printf)
+    std::vector<KernelParam> params;              ///< the kernel's parameters as the run set them
     uint32_t threads = 0;
     std::shared_ptr<const TimingRun> timing;  ///< Engine::timing: the chip and its counters
     std::shared_ptr<const Profile> profile;   ///< RenderOptions::profile: by function and line

@@ -218,6 +218,27 @@ void register_stats(const RenderResult& r, stats::Registry& reg) {
         number(
             "host/bvh_seconds", [&r] { return r.bvh_seconds; }, "BVH build time", "s");
     }
+    if (r.wide_bvh) {
+        const scene::WideBvhStats& w = *r.wide_bvh;
+        number(
+            "wide_bvh/width", [&w] { return w.width; }, "children per wide BVH node, at most");
+        number(
+            "wide_bvh/nodes", [&w] { return w.nodes; }, "wide BVH nodes");
+        number(
+            "wide_bvh/leaves", [&w] { return w.leaves; }, "wide BVH leaves");
+        number(
+            "wide_bvh/max_depth", [&w] { return w.max_depth; },
+            "wide nodes from the root to the deepest leaf");
+        number(
+            "wide_bvh/mean_children", [&w] { return w.mean_children; },
+            "children per wide node, on average");
+        number(
+            "wide_bvh/worst_stack", [&w] { return w.worst_stack; },
+            "most traversal-stack entries a ray could need");
+        number(
+            "host/wide_bvh_seconds", [&w] { return w.collapse_seconds; },
+            "time to collapse the binary BVH into the wide one", "s");
+    }
     if (r.grid) {
         const scene::GridStats& g = *r.grid;
         number(
@@ -409,6 +430,14 @@ void print_summary(const RenderOptions& options, const RenderResult& r,
                    r.bvh->depth_limited_nodes
                        ? fmt::format(" (depth limit shaped {} nodes)", r.bvh->depth_limited_nodes)
                        : "");
+    if (r.wide_bvh) {
+        const scene::WideBvhStats& w = *r.wide_bvh;
+        fmt::print(out,
+                   "{:<8} {} nodes, {} leaves, depth {}, {:.2f} children per node, {} boxes, "
+                   "collapsed in {:.3f} s\n",
+                   scene::to_string(r.accel), w.nodes, w.leaves, w.max_depth, w.mean_children,
+                   scene::to_string(options.bvh.boxes), w.collapse_seconds);
+    }
     if (r.grid) {
         const scene::GridStats& g = *r.grid;
         fmt::print(out,
@@ -509,6 +538,7 @@ nlohmann::ordered_json stats_document(const RenderOptions& options, const Render
     run["max_leaf"] = options.bvh.max_leaf_size;
     run["bvh_order"] = scene::to_string(options.bvh.order);
     run["bvh_align_pairs"] = options.bvh.align_pairs;
+    run["bvh_boxes"] = scene::to_string(options.bvh.boxes);
     run["width"] = r.scene.width;
     run["height"] = r.scene.height;
     run["samples_per_pixel"] = r.scene.samples_per_pixel;

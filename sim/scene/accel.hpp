@@ -1,6 +1,7 @@
 // The acceleration structures tpsim builds for a kernel: which one follows from the marker the
-// kernel's ELF defines (TRAX_USES_BVH, TRAX_USES_GRID); `render --accel` and the sweep key
-// `accel` name one and pick its default kernel.
+// kernel's ELF defines (TRAX_USES_BVH, TRAX_USES_WIDE_BVH, TRAX_USES_GRID); `render --accel`
+// and the sweep key `accel` name one (for a marker that several share, the one to build) and
+// pick its default kernel.
 #pragma once
 #include <array>
 #include <optional>
@@ -8,11 +9,15 @@
 #include <string_view>
 #include <vector>
 
+#include "kernel/scene_layout.hpp"
+
 namespace tpsim::scene {
 
 enum class AccelStructure {
     none,  ///< brute force: the kernel tests every triangle
     bvh2,  ///< the binary BVH (sim/scene/bvh.hpp)
+    bvh4,  ///< the binary BVH collapsed to 4 children per node (sim/scene/wide_bvh.hpp)
+    bvh8,  ///< ... to 8 children per node
     grid,  ///< the uniform grid (sim/scene/grid.hpp)
 };
 
@@ -20,19 +25,32 @@ struct AccelInfo {
     AccelStructure structure;
     std::string_view name;            ///< as --accel and the statistics file spell it
     std::string_view default_kernel;  ///< the tracer that traverses it
+    std::string_view marker;          ///< the symbol a kernel that traverses it defines
     std::string_view description;     ///< for messages: "the uniform grid"
 };
 
 /// Every structure --accel may name (not `none`: brute force is chosen by its kernel).
 constexpr std::array kAccelStructures = {
-    AccelInfo{AccelStructure::bvh2, "bvh2", "tracer", "the binary BVH"},
-    AccelInfo{AccelStructure::grid, "grid", "tracer_grid", "the uniform grid"},
+    AccelInfo{AccelStructure::bvh2, "bvh2", "tracer", trax::layout::kUsesBvhSymbol,
+              "the binary BVH"},
+    AccelInfo{AccelStructure::bvh4, "bvh4", "tracer_wide", trax::layout::kUsesWideBvhSymbol,
+              "the 4-wide BVH"},
+    AccelInfo{AccelStructure::bvh8, "bvh8", "tracer_wide", trax::layout::kUsesWideBvhSymbol,
+              "the 8-wide BVH"},
+    AccelInfo{AccelStructure::grid, "grid", "tracer_grid", trax::layout::kUsesGridSymbol,
+              "the uniform grid"},
 };
 
 constexpr AccelInfo accel_info(AccelStructure structure) {
     for (const AccelInfo& info : kAccelStructures)
         if (info.structure == structure) return info;
-    return {AccelStructure::none, "none", "primary_brute", "no structure (every triangle tested)"};
+    return {AccelStructure::none, "none", "primary_brute", "",
+            "no structure (every triangle tested)"};
+}
+
+/// Children per node of a wide BVH; 0 for the other structures.
+constexpr uint32_t wide_bvh_width(AccelStructure structure) {
+    return structure == AccelStructure::bvh4 ? 4 : structure == AccelStructure::bvh8 ? 8 : 0;
 }
 
 constexpr std::string_view to_string(AccelStructure structure) {

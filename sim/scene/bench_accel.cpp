@@ -1,7 +1,8 @@
 // bench_accel [--threads N] [scene-or-mesh ...]: loads each scene and builds each acceleration
 // structure: the BVH with both SAH builders (build time as wall clock and the process's CPU
 // time, all threads; node count, depth, SAH cost), the BVH's image layout in each node order,
-// and the uniform grid by the density rule. Defaults to the bunny and the stress scene, and to
+// its collapse into the 4- and 8-wide BVHs and their layout in both box formats, and the
+// uniform grid by the density rule. Defaults to the bunny and the stress scene, and to
 // oneTBB's default thread count (the host's cores).
 #include <chrono>
 #include <ctime>
@@ -18,6 +19,7 @@
 #include "sim/scene/bvh.hpp"
 #include "sim/scene/grid.hpp"
 #include "sim/scene/load_scene.hpp"
+#include "sim/scene/wide_bvh.hpp"
 
 namespace {
 
@@ -75,6 +77,24 @@ int main(int argc, char** argv) {
                 fmt::print("{:<14} {:<34} {:>9.1f} {:>9.1f} {:>10.1f} M {:>10}\n", scene.name,
                            fmt::format("bvh2 layout, {}", to_string(order)), wall * 1e3, cpu * 1e3,
                            double(nodes.size() * sizeof(nodes[0])) / (1 << 20), "-");
+            }
+            for (uint32_t width : {4u, 8u}) {
+                double cpu_start = cpu_seconds();
+                auto start = std::chrono::steady_clock::now();
+                const WideBvh wide = collapse_bvh(bvh, width);
+                fmt::print("{:<14} {:<34} {:>9.1f} {:>9.1f} {:>12} {:>10}\n", scene.name,
+                           fmt::format("bvh{} collapse", width), seconds_since(start) * 1e3,
+                           (cpu_seconds() - cpu_start) * 1e3, "-", "-");
+                for (BvhBoxes boxes : kBvhBoxes) {
+                    cpu_start = cpu_seconds();
+                    start = std::chrono::steady_clock::now();
+                    const auto words = tpsim::image::compile_wide_bvh(
+                        wide, BvhOrder::breadth_first, boxes, 0);
+                    fmt::print("{:<14} {:<34} {:>9.1f} {:>9.1f} {:>10.1f} M {:>10}\n", scene.name,
+                               fmt::format("bvh{} layout, {} boxes", width, to_string(boxes)),
+                               seconds_since(start) * 1e3, (cpu_seconds() - cpu_start) * 1e3,
+                               double(words.size() * 4) / (1 << 20), "-");
+                }
             }
             const double cpu_start = cpu_seconds();
             const auto start = std::chrono::steady_clock::now();

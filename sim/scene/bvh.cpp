@@ -43,6 +43,19 @@ const char* to_string(BvhBuilder builder) {
                                           : "median";
 }
 
+std::vector<std::string> bvh_builder_names() {
+    std::vector<std::string> names;
+    for (BvhBuilder builder : kBvhBuilders)
+        names.emplace_back(to_string(builder));
+    return names;
+}
+
+std::optional<BvhBuilder> find_bvh_builder(std::string_view name) {
+    for (BvhBuilder builder : kBvhBuilders)
+        if (name == to_string(builder)) return builder;
+    return std::nullopt;
+}
+
 const char* to_string(BvhOrder order) {
     return order == BvhOrder::breadth_first ? "breadth-first"
            : order == BvhOrder::depth_first ? "depth-first"
@@ -59,6 +72,23 @@ std::vector<std::string> bvh_order_names() {
 std::optional<BvhOrder> find_bvh_order(std::string_view name) {
     for (BvhOrder order : kBvhOrders)
         if (name == to_string(order)) return order;
+    return std::nullopt;
+}
+
+const char* to_string(BvhBoxes boxes) {
+    return boxes == BvhBoxes::floats ? "float" : "quantized";
+}
+
+std::vector<std::string> bvh_boxes_names() {
+    std::vector<std::string> names;
+    for (BvhBoxes boxes : kBvhBoxes)
+        names.emplace_back(to_string(boxes));
+    return names;
+}
+
+std::optional<BvhBoxes> find_bvh_boxes(std::string_view name) {
+    for (BvhBoxes boxes : kBvhBoxes)
+        if (name == to_string(boxes)) return boxes;
     return std::nullopt;
 }
 

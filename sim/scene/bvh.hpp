@@ -35,6 +35,8 @@ struct BvhNode {
 /// median: no SAH, the object median on the widest centroid axis until a node fits in a leaf;
 /// the baseline the SAH builders are measured against (docs/course/experiments.md).
 enum class BvhBuilder { binned, sweep, median };
+inline constexpr BvhBuilder kBvhBuilders[] = {BvhBuilder::sweep, BvhBuilder::binned,
+                                              BvhBuilder::median};
 
 /// The order the scene compiler lays the nodes out in (image::build_memory_image). The image
 /// stores the two children of a node side by side (a sibling pair, 64 bytes), so every order is
@@ -50,6 +52,16 @@ enum class BvhBuilder { binned, sweep, median };
 enum class BvhOrder { breadth_first, depth_first, van_emde_boas };
 inline constexpr BvhOrder kBvhOrders[] = {BvhOrder::breadth_first, BvhOrder::depth_first,
                                           BvhOrder::van_emde_boas};
+
+/// How the scene compiler stores a wide node's child boxes (image::compile_wide_bvh).
+///   floats: six floats per child, as the binary BVH does.
+///   quantized: the node's box origin and a power-of-two scale per axis, and each child's box as
+///     six 8-bit offsets on that grid, rounded outwards (Ylitie, Karras and Laine, "Efficient
+///     Incoherent Ray Traversal on GPUs Through Compressed Wide BVHs", HPG 2017): half the
+///     bytes per node, a few more instructions per box, and boxes a little larger, never
+///     smaller, than the float ones.
+enum class BvhBoxes { floats, quantized };
+inline constexpr BvhBoxes kBvhBoxes[] = {BvhBoxes::floats, BvhBoxes::quantized};
 
 struct BvhConfig {
     BvhBuilder builder = BvhBuilder::sweep;
@@ -69,6 +81,8 @@ struct BvhConfig {
     /// boundary and fills one line (32 bytes more). Off, the root fills the first half line and
     /// every pair straddles two lines: the layout the reference figures were measured with.
     bool align_pairs = false;
+    /// How a wide BVH's child boxes are stored (the binary BVH's are floats).
+    BvhBoxes boxes = BvhBoxes::floats;
 };
 
 struct BvhStats {
@@ -99,10 +113,17 @@ Bvh build_bvh(std::span<const Triangle> triangles, const BvhConfig& config = {})
 double sah_cost(const Bvh& bvh);
 
 const char* to_string(BvhBuilder builder);
+/// Every builder's name (to_string), for the command line's and the sweep file's choices.
+std::vector<std::string> bvh_builder_names();
+std::optional<BvhBuilder> find_bvh_builder(std::string_view name);
 const char* to_string(BvhOrder order);
 /// Every order's name (to_string), for the command line's and the sweep file's choices.
 std::vector<std::string> bvh_order_names();
 /// The order that to_string names `name`, or nullopt.
 std::optional<BvhOrder> find_bvh_order(std::string_view name);
+const char* to_string(BvhBoxes boxes);
+/// Every box format's name, for the command line's and the sweep file's choices.
+std::vector<std::string> bvh_boxes_names();
+std::optional<BvhBoxes> find_bvh_boxes(std::string_view name);
 
 }  // namespace tpsim::scene

@@ -31,6 +31,7 @@ struct JobRun {
     uint32_t max_leaf = 8;
     std::string bvh_order = "breadth-first";  ///< scene::BvhOrder, as to_string names it
     bool bvh_align_pairs = false;             ///< scene::BvhConfig::align_pairs
+    std::string bvh_boxes = "float";          ///< scene::BvhBoxes, as to_string names it
     uint32_t width = 0, height = 0, spp = 0;  ///< 0: the scene's
     uint32_t seed = 0;
     std::string timing = "cycle";  ///< cycle, sampled or none (render --timing)
@@ -76,9 +77,9 @@ using KernelResolver = std::function<std::filesystem::path(const std::string&)>;
 
 /// The settings a sweep file may name besides chip configuration keys.
 inline constexpr const char* kRunSettings[] = {
-    "scene",        "kernel", "config",   "accel",     "grid_resolution",
-    "grid_density", "bvh",    "max_leaf", "bvh_order", "bvh_align_pairs",
-    "width",        "height", "spp",      "seed",      "timing"};
+    "scene",  "kernel",   "config",    "accel",           "grid_resolution", "grid_density",
+    "bvh",    "max_leaf", "bvh_order", "bvh_align_pairs", "bvh_boxes",       "width",
+    "height", "spp",      "seed",      "timing"};
 
 /// Reads, checks and expands a sweep file. Throws tpsim::Error with one line naming
 /// file:line for anything wrong (unknown key, bad value, missing scene, empty axis, zip groups

@@ -21,7 +21,7 @@ namespace {
 constexpr std::uintmax_t kMaxSweepFileBytes = 1 << 20;
 /// More jobs than this is a mistake in the file, not a study (each job is one render).
 constexpr size_t kMaxJobs = 100000;
-constexpr int kPlanVersion = 1;
+constexpr int kPlanVersion = 2;
 
 /// A setting's value and the line it is written on.
 struct Value {
@@ -258,13 +258,15 @@ private:
         } else if (name == "grid_density") {
             run.grid_density = number(name, v, 1.0 / 1024, scene::kGridMaxDensity);
         } else if (name == "bvh") {
-            run.bvh = one_of(name, v, {"sweep", "binned", "median"});
+            run.bvh = one_of(name, v, scene::bvh_builder_names());
         } else if (name == "bvh_order") {
             run.bvh_order = one_of(name, v, scene::bvh_order_names());
         } else if (name == "bvh_align_pairs") {
             if (!v.value.is_boolean())
                 fail(v.line, fmt::format("{} must be true or false, got {}", name, v.value.dump()));
             run.bvh_align_pairs = v.value.get<bool>();
+        } else if (name == "bvh_boxes") {
+            run.bvh_boxes = one_of(name, v, scene::bvh_boxes_names());
         } else if (name == "max_leaf") {
             run.max_leaf = uint32_t(integer(name, v, 1, 8));
         } else if (name == "width") {
@@ -501,6 +503,7 @@ void write_plan(const Sweep& sweep, const std::filesystem::path& dir) {
                           {"max_leaf", r.max_leaf},
                           {"bvh_order", r.bvh_order},
                           {"bvh_align_pairs", r.bvh_align_pairs},
+                          {"bvh_boxes", r.bvh_boxes},
                           {"width", r.width},
                           {"height", r.height},
                           {"spp", r.spp},
@@ -570,6 +573,7 @@ Sweep read_plan(const std::filesystem::path& dir) {
             job.run.max_leaf = r.at("max_leaf").get<uint32_t>();
             job.run.bvh_order = r.at("bvh_order").get<std::string>();
             job.run.bvh_align_pairs = r.at("bvh_align_pairs").get<bool>();
+            job.run.bvh_boxes = r.at("bvh_boxes").get<std::string>();
             job.run.width = r.at("width").get<uint32_t>();
             job.run.height = r.at("height").get<uint32_t>();
             job.run.spp = r.at("spp").get<uint32_t>();

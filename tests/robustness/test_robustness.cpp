@@ -1,7 +1,7 @@
 // Stiff and extreme ray-tracing cases (docs/robustness.md), traced by the ray_query kernels
-// through the tracer's BVH traversal and through the uniform grid, on the functional simulator
-// AND the native twin: every result must agree bit for bit between the two, and meet the
-// geometric expectation, for either structure.
+// through every structure (the tracer's BVH traversal, the wide BVHs in both box formats, the
+// uniform grid), on the functional simulator AND the native twin: every result must agree bit
+// for bit between the two, and meet the geometric expectation, for each structure.
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -17,6 +17,7 @@
 #include "sim/scene/bvh.hpp"
 #include "sim/scene/grid.hpp"
 #include "tests/robustness/ray_query_run.hpp"
+#include "tests/scene/wide_bvh_image.hpp"
 
 using namespace tpsim;
 using trax::layout::Ray;
@@ -117,27 +118,20 @@ Ray make_ray(glm::vec3 origin, glm::vec3 dir, float t_max, int mode = trax::layo
 }
 
 using scene::AccelStructure;
+using test::AccelVariant;
 
-/// Each test runs once per structure.
+/// Each test runs once per structure (and wide-BVH box format).
 #define EACH_STRUCTURE                                                                             \
-    const AccelStructure structure = GENERATE(AccelStructure::bvh2, AccelStructure::grid);         \
-    INFO("through the " << scene::to_string(structure))
+    const AccelVariant variant =                                                                   \
+        GENERATE(from_range(std::begin(test::kAccelVariants), std::end(test::kAccelVariants)));    \
+    INFO("through the " << test::to_string(variant))
 
 struct Queries {
-    std::optional<scene::Bvh> bvh;
-    std::optional<scene::Grid> grid;
+    explicit Queries(test::BuiltAccel b) : built(std::move(b)) {}
+    test::BuiltAccel built;
     std::vector<RayResult> results;  ///< one per ray, identical on both engines
-    /// The scene triangle behind an image triangle index (the BVH's are in leaf order).
-    uint32_t scene_triangle(int32_t image_index) const {
-        return bvh ? bvh->triangle_order[size_t(image_index)] : uint32_t(image_index);
-    }
-    /// Most nodes (cells) one ray can visit: every node once; a straight line crosses at most
-    /// res_x + res_y + res_z - 2 cells.
-    uint64_t most_nodes() const {
-        return bvh ? bvh->nodes.size()
-                   : uint64_t(grid->stats.resolution[0]) + grid->stats.resolution[1] +
-                         grid->stats.resolution[2] - 2;
-    }
+    uint32_t scene_triangle(int32_t image_index) const { return built.scene_triangle(image_index); }
+    uint64_t most_nodes() const { return built.most_nodes(); }
 };
 
 scene::Bvh bvh_for(const Mesh& mesh) {
@@ -148,18 +142,10 @@ scene::Bvh bvh_for(const Mesh& mesh) {
 
 /// Runs the structure's ray_query kernel over `rays` on both engines; REQUIREs that they agree
 /// bit for bit.
-Queries run_queries(const Mesh& mesh, const std::vector<Ray>& rays, AccelStructure structure) {
-    Queries q;
-    image::Accel accel;
-    if (structure == AccelStructure::grid) {
-        q.grid = scene::build_grid(mesh);
-        accel = &*q.grid;
-    } else {
-        q.bvh = bvh_for(mesh);
-        accel = &*q.bvh;
-    }
+Queries run_queries(const Mesh& mesh, const std::vector<Ray>& rays, AccelVariant variant) {
+    Queries q{test::BuiltAccel(mesh, variant)};
     test::RayQueryRun run =
-        test::run_ray_query(mesh, accel, rays, 20000 * uint64_t(rays.size()) + 100000);
+        test::run_ray_query(mesh, q.built, rays, 20000 * uint64_t(rays.size()) + 100000);
     // A kRayFromSurface query whose first ray hit traces a second one.
     size_t second_rays = 0;
     for (size_t i = 0; i < rays.size(); ++i)
@@ -194,14 +180,14 @@ std::vector<glm::vec3> vertices_and_edge_midpoints(const Mesh& mesh) {
 
 /// Rays from `inside` aimed exactly at every vertex and edge midpoint, closest- and any-hit:
 /// a closed mesh must catch every one (zero leaks) at t ~ 1 (the target is on the surface).
-void check_no_leaks(const Mesh& mesh, glm::vec3 inside, AccelStructure structure) {
+void check_no_leaks(const Mesh& mesh, glm::vec3 inside, AccelVariant variant) {
     const std::vector<glm::vec3> targets = vertices_and_edge_midpoints(mesh);
     std::vector<Ray> rays;
     for (const glm::vec3& target : targets) {
         rays.push_back(make_ray(inside, target - inside, kInf));
         rays.push_back(make_ray(inside, target - inside, kInf, trax::layout::kRayAnyHit));
     }
-    const Queries q = run_queries(mesh, rays, structure);
+    const Queries q = run_queries(mesh, rays, variant);
     size_t leaks = 0, closest_off = 0;
     for (size_t i = 0; i < rays.size(); ++i) {
         const RayResult& r = q.results[i];
@@ -235,14 +221,14 @@ TEST_CASE("robustness: rays at every vertex and edge of closed meshes never leak
         SECTION(std::string("grid cube, ") + p.name) {
             // The centre, and an off-centre point: different directions hit different edges.
             check_no_leaks(transformed(cube, p.scale, p.offset),
-                           glm::vec3(0.5f) * p.scale + p.offset, structure);
+                           glm::vec3(0.5f) * p.scale + p.offset, variant);
             check_no_leaks(transformed(cube, p.scale, p.offset),
-                           glm::vec3(0.3f, 0.55f, 0.7f) * p.scale + p.offset, structure);
+                           glm::vec3(0.3f, 0.55f, 0.7f) * p.scale + p.offset, variant);
         }
         SECTION(std::string("icosphere, ") + p.name) {
-            check_no_leaks(transformed(sphere, p.scale, p.offset), p.offset, structure);
+            check_no_leaks(transformed(sphere, p.scale, p.offset), p.offset, variant);
             check_no_leaks(transformed(sphere, p.scale, p.offset),
-                           glm::vec3(0.2f, -0.3f, 0.1f) * p.scale + p.offset, structure);
+                           glm::vec3(0.2f, -0.3f, 0.1f) * p.scale + p.offset, variant);
         }
     }
 }
@@ -265,7 +251,7 @@ TEST_CASE("robustness: grazing rays inside a closed cube always hit, at the righ
             expected.push_back(std::min(0.9f, gap / std::max(rise, 1e-30f)));
         }
     }
-    const Queries q = run_queries(cube, rays, structure);
+    const Queries q = run_queries(cube, rays, variant);
     for (size_t i = 0; i < rays.size(); ++i) {
         INFO("ray " << i);
         CHECK(q.results[i].triangle >= 0);
@@ -280,7 +266,7 @@ TEST_CASE("robustness: axis-aligned rays with the origin on BVH box and grid cel
     const Mesh cube = grid_cube(4);
     // The planes the structure's traversal computes distances to: node boxes' or cell faces'.
     std::array<std::vector<float>, 3> planes;
-    if (structure == AccelStructure::grid) {
+    if (variant.structure == AccelStructure::grid) {
         const scene::Grid grid = scene::build_grid(cube);
         for (int axis = 0; axis < 3; ++axis)
             for (uint32_t c = 0; c <= grid.stats.resolution[size_t(axis)]; ++c) {
@@ -289,6 +275,20 @@ TEST_CASE("robustness: axis-aligned rays with the origin on BVH box and grid cel
                     (grid.hi[axis] - grid.lo[axis]) / float(grid.stats.resolution[size_t(axis)]);
                 planes[size_t(axis)].push_back(grid.lo[axis] + float(c) * cell);
             }
+    } else if (scene::wide_bvh_width(variant.structure) != 0) {
+        // The child boxes as the kernel decodes them (quantized ones lie on their own grid).
+        const test::BuiltAccel built(cube, variant);
+        scene::Scene s;
+        s.triangles = cube;
+        s.materials.resize(1);
+        s.width = s.height = 1;
+        for (const test::ImageWideNode& node :
+             test::read_wide_bvh(image::build_memory_image(s, built.accel(), 1)))
+            for (const test::ImageWideChild& child : node.children)
+                for (int axis = 0; axis < 3; ++axis) {
+                    planes[size_t(axis)].push_back(child.lo[axis]);
+                    planes[size_t(axis)].push_back(child.hi[axis]);
+                }
     } else {
         for (const scene::BvhNode& node : bvh_for(cube).nodes)
             for (int axis = 0; axis < 3; ++axis) {
@@ -313,7 +313,7 @@ TEST_CASE("robustness: axis-aligned rays with the origin on BVH box and grid cel
                 }
         }
     REQUIRE(!rays.empty());
-    const Queries q = run_queries(cube, rays, structure);
+    const Queries q = run_queries(cube, rays, variant);
     size_t wrong = 0;
     for (size_t i = 0; i < rays.size(); ++i)
         wrong += q.results[i].triangle < 0 || std::abs(q.results[i].t - expected[i]) > 1e-6f;
@@ -340,7 +340,7 @@ TEST_CASE("robustness: degenerate and zero-area triangles are never hit and give
             rays.push_back(make_ray(o, target - o, kInf));
             rays.push_back(make_ray(o, target - o, kInf, trax::layout::kRayAnyHit));
         }
-    const Queries q = run_queries(mesh, rays, structure);
+    const Queries q = run_queries(mesh, rays, variant);
     for (size_t i = 0; i < rays.size(); ++i) {
         const RayResult& r = q.results[i];
         INFO("ray " << i);
@@ -375,7 +375,7 @@ TEST_CASE("robustness: NaN and infinite rays terminate without overflow, NaN ray
     rays.push_back(make_ray(glm::vec3(kNaN), glm::vec3(kNaN), kNaN));
     must_miss.push_back(true);
 
-    const Queries q = run_queries(sphere, rays, structure);  // finite instruction budget: no hang
+    const Queries q = run_queries(sphere, rays, variant);  // finite instruction budget: no hang
     for (size_t i = 0; i < rays.size(); ++i) {
         const RayResult& r = q.results[i];
         INFO("ray " << i);
@@ -414,7 +414,7 @@ TEST_CASE("robustness: rays leaving a surface never hit their own triangle", "[r
                 }
             }
         }
-        const Queries q = run_queries(mesh, rays, structure);
+        const Queries q = run_queries(mesh, rays, variant);
         size_t surface_misses = 0, self_hits = 0, inward_misses = 0, outward_hits = 0;
         for (size_t i = 0; i < rays.size(); ++i) {
             const RayResult& r = q.results[i];
@@ -454,7 +454,7 @@ TEST_CASE("robustness: a hit point on a large floor at y = 0 does not shadow its
                                         trax::layout::kRayFromSurface | trax::layout::kRayAnyHit,
                                         light));
         }
-    const Queries q = run_queries(floor, rays, structure);
+    const Queries q = run_queries(floor, rays, variant);
     size_t missed = 0, shadowed = 0;
     for (const RayResult& r : q.results) {
         missed += r.surface_triangle < 0;

@@ -384,21 +384,10 @@ std::vector<std::pair<glm::vec3, glm::vec3>> camera_rays(const Case& c) {
 /// Runs the case's queries on both engines (bit-identical results required) and returns the
 /// results and the image's triangles in image order, as doubles.
 std::pair<std::vector<layout::RayResult>, std::vector<DTri>>
-run_case(const Case& c, const std::vector<layout::Ray>& rays, scene::AccelStructure structure) {
-    scene::BvhConfig config;
-    config.traversal_stack_entries = layout::kTraversalStackEntries;
-    std::optional<scene::Bvh> bvh;
-    std::optional<scene::Grid> grid;
-    image::Accel accel;
-    if (structure == scene::AccelStructure::grid) {
-        grid = scene::build_grid(c.mesh);
-        accel = &*grid;
-    } else {
-        bvh = scene::build_bvh(c.mesh, config);
-        accel = &*bvh;
-    }
+run_case(const Case& c, const std::vector<layout::Ray>& rays, test::AccelVariant variant) {
+    const test::BuiltAccel built(c.mesh, variant);
     const test::RayQueryRun run =
-        test::run_ray_query(c.mesh, accel, rays, 60000 * uint64_t(rays.size()) + 100000);
+        test::run_ray_query(c.mesh, built, rays, 60000 * uint64_t(rays.size()) + 100000);
     for (const image::TraversalTotals& totals : run.totals)
         CHECK(totals.stack_overflows == 0);
     // The float triangles the kernel saw.
@@ -422,7 +411,7 @@ struct Decisions {
     std::vector<float> surface_t;
 };
 
-Tally check_case(const Case& c, scene::AccelStructure structure, Decisions& decisions) {
+Tally check_case(const Case& c, test::AccelVariant variant, Decisions& decisions) {
     const auto camera = camera_rays(c);
     std::vector<layout::Ray> rays;
     for (const auto& [o, d] : camera)
@@ -432,7 +421,7 @@ Tally check_case(const Case& c, scene::AccelStructure structure, Decisions& deci
                             3.0e38f,
                             layout::kRayFromSurface | layout::kRayAnyHit,
                             {light.x, light.y, light.z}});
-    const auto [results, tris] = run_case(c, rays, structure);
+    const auto [results, tris] = run_case(c, rays, variant);
     for (const layout::RayResult& r : results) {
         decisions.surface_hit.push_back(r.surface_triangle >= 0);
         decisions.surface_t.push_back(r.surface_t);
@@ -503,32 +492,37 @@ Tally check_case(const Case& c, scene::AccelStructure structure, Decisions& deci
 }  // namespace
 
 TEST_CASE("shadow oracle: no holes, false shadows or leaks on the corpus, against double and "
-          "Embree, through the BVH and the uniform grid",
+          "Embree, through the BVHs and the uniform grid",
           "[robustness][oracle]") {
     Tally total;
-    // Where the grid's kernel decides otherwise than the BVH's: a camera ray's hit or miss, its
-    // distance (the same watertight test on the same triangle gives the same bits; a tie
-    // between two triangles at one distance may pick either), a shadow ray's verdict. A tie
-    // on a shared edge may pick the other triangle, whose normal offsets the shadow ray's
-    // origin otherwise: so shadow verdicts may differ, but only where the oracle calls them
-    // ambiguous (an occluder within a few ulps of the start).
+    // Where another structure's kernel decides otherwise than the binary BVH's: a camera ray's
+    // hit or miss, its distance (the same watertight test on the same triangle gives the same
+    // bits; a tie between two triangles at one distance may pick either), a shadow ray's
+    // verdict. A tie on a shared edge may pick the other triangle, whose normal offsets the
+    // shadow ray's origin otherwise: so shadow verdicts may differ, but only where the oracle
+    // calls them ambiguous (an occluder within a few ulps of the start).
+    // Each width and each box format once (test_robustness runs every combination).
+    using scene::AccelStructure;
+    const test::AccelVariant variants[] = {{AccelStructure::bvh2},
+                                           {AccelStructure::bvh4, scene::BvhBoxes::quantized},
+                                           {AccelStructure::bvh8},
+                                           {AccelStructure::grid}};
+    constexpr size_t kVariants = std::size(variants);
     size_t hit_differs = 0, distance_differs = 0, shadow_differs = 0, clear_shadow_differs = 0,
            queries = 0;
     for (const Case& c : corpus()) {
         INFO(c.name);
-        Decisions by_structure[2];
-        const scene::AccelStructure structures[2] = {scene::AccelStructure::bvh2,
-                                                     scene::AccelStructure::grid};
-        for (int k = 0; k < 2; ++k) {
-            const Tally t = check_case(c, structures[k], by_structure[k]);
-            std::printf("%-42s %-4s %5zu tris: primary %5zu (ambiguous %zu, holes %zu, wrong "
+        Decisions by_variant[kVariants];
+        for (size_t k = 0; k < kVariants; ++k) {
+            const std::string name = test::to_string(variants[k]);
+            const Tally t = check_case(c, variants[k], by_variant[k]);
+            std::printf("%-42s %-14s %5zu tris: primary %5zu (ambiguous %zu, holes %zu, wrong "
                         "%zu, phantom %zu), shadow %5zu (ambiguous %zu, false %zu, leaks %zu), "
                         "embree disagrees %zu\n",
-                        c.name.c_str(), std::string(scene::to_string(structures[k])).c_str(),
-                        c.mesh.size(), t.primary, t.primary_ambiguous, t.holes, t.wrong_first_hit,
-                        t.phantom_hits, t.shadow, t.shadow_ambiguous, t.false_shadows, t.leaks,
-                        t.embree_disagreements);
-            INFO("through the " << scene::to_string(structures[k]));
+                        c.name.c_str(), name.c_str(), c.mesh.size(), t.primary, t.primary_ambiguous,
+                        t.holes, t.wrong_first_hit, t.phantom_hits, t.shadow, t.shadow_ambiguous,
+                        t.false_shadows, t.leaks, t.embree_disagreements);
+            INFO("through the " << name);
             CHECK(t.holes == 0);
             CHECK(t.wrong_first_hit == 0);
             CHECK(t.phantom_hits == 0);
@@ -536,23 +530,27 @@ TEST_CASE("shadow oracle: no holes, false shadows or leaks on the corpus, agains
             CHECK(t.leaks == 0);
             total.add(t);
         }
-        const Decisions &bvh = by_structure[0], &grid = by_structure[1];
-        REQUIRE(bvh.blocked.size() == grid.blocked.size());
-        for (size_t i = 0; i < bvh.blocked.size(); ++i) {
-            hit_differs += bvh.surface_hit[i] != grid.surface_hit[i];
-            distance_differs +=
-                bvh.surface_hit[i] && grid.surface_hit[i] && bvh.surface_t[i] != grid.surface_t[i];
-            shadow_differs += bvh.blocked[i] != grid.blocked[i];
-            clear_shadow_differs += bvh.blocked[i] != grid.blocked[i] && !bvh.shadow_ambiguous[i] &&
-                                    !grid.shadow_ambiguous[i];
+        const Decisions& bvh = by_variant[0];
+        for (size_t k = 1; k < kVariants; ++k) {
+            const Decisions& other = by_variant[k];
+            REQUIRE(bvh.blocked.size() == other.blocked.size());
+            for (size_t i = 0; i < bvh.blocked.size(); ++i) {
+                hit_differs += bvh.surface_hit[i] != other.surface_hit[i];
+                distance_differs += bvh.surface_hit[i] && other.surface_hit[i] &&
+                                    bvh.surface_t[i] != other.surface_t[i];
+                shadow_differs += bvh.blocked[i] != other.blocked[i];
+                clear_shadow_differs += bvh.blocked[i] != other.blocked[i] &&
+                                        !bvh.shadow_ambiguous[i] && !other.shadow_ambiguous[i];
+            }
+            queries += bvh.blocked.size();
         }
-        queries += bvh.blocked.size();
     }
     std::printf("total: %zu camera rays (%zu ambiguous), %zu shadow rays (%zu ambiguous), "
                 "embree disagrees %zu\n",
                 total.primary, total.primary_ambiguous, total.shadow, total.shadow_ambiguous,
                 total.embree_disagreements);
-    std::printf("grid against BVH over %zu queries: %zu camera-ray hit/miss, %zu distances, %zu "
+    std::printf("the other structures against the binary BVH over %zu queries: %zu camera-ray "
+                "hit/miss, %zu distances, %zu "
                 "shadow verdicts differ (%zu outside the oracle's ambiguity band)\n",
                 queries, hit_differs, distance_differs, shadow_differs, clear_shadow_differs);
     CHECK(hit_differs == 0);

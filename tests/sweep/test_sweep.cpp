@@ -155,7 +155,7 @@ TEST_CASE("sweep: bad sweep files are one line naming file:line", "[sweep]") {
     CHECK(error_of(dir, "scene = \"scenes/a.toml\"\nl1.size_bites = [1024]\n") ==
           file + ":2: unknown setting 'l1.size_bites': give a run setting (scene, kernel, "
                  "config, accel, grid_resolution, grid_density, bvh, max_leaf, bvh_order, "
-                 "bvh_align_pairs, width, height, spp, seed, timing), a chip "
+                 "bvh_align_pairs, bvh_boxes, width, height, spp, seed, timing), a chip "
                  "configuration key such as l1.size_bytes (configs/trax.toml lists them), or "
                  "zip");
     CHECK(error_of(dir, "scene = \"scenes/a.toml\"\nbvh = []\n") ==

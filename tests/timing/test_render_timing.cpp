@@ -1,6 +1,7 @@
 // End to end on the tracer kernel: the cycle-level engine is deterministic and never changes
 // the image, whatever the timing parameters (functional-first: timing decides only *when*).
 #include "sim/core/elf_loader.hpp"
+#include "sim/core/host_threads.hpp"
 #include "sim/image/memory_image.hpp"
 #include "sim/render/render.hpp"
 #include "sim/render/report.hpp"
@@ -19,7 +20,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <regex>
+#include <set>
 #include <sstream>
 
 using namespace tpsim;
@@ -138,25 +141,86 @@ TEST_CASE("BVH node orders move the traffic, never the image or the instructions
         }
 }
 
+TEST_CASE("The wide BVHs render the binary BVH's image in both box formats, the same on one "
+          "and on two host threads",
+          "[render][invariance][wide]") {
+    const auto reference = render_cornell(render::Engine::timing, tiny());
+    const auto stat = [](const render::RenderResult& result, const char* key) {
+        stats::Registry all;
+        render::register_stats(result, all);
+        return all.value(key);
+    };
+    for (scene::AccelStructure structure :
+         {scene::AccelStructure::bvh4, scene::AccelStructure::bvh8}) {
+        double float_bytes = 0;
+        for (scene::BvhBoxes boxes : scene::kBvhBoxes) {
+            INFO(scene::to_string(structure) << " " << scene::to_string(boxes));
+            std::optional<render::RenderResult> first;
+            for (uint32_t host_threads : {1u, 2u}) {
+                core::set_host_threads(host_threads);
+                render::RenderOptions options;
+                options.scene = small_cornell();
+                options.kernel = TPSIM_KERNEL_DIR "/tracer_wide.elf";
+                options.engine = render::Engine::timing;
+                options.chip = tiny();
+                // The wide traversal's stack (64 entries) does not fit the tiny chip's 1 KiB.
+                options.chip.tp.local_store_bytes = 2048;
+                options.chip.chip.num_tms = 2;  // one per host thread
+                options.accel = structure;
+                options.bvh.boxes = boxes;
+                auto result = render::render(options);
+                CHECK(same_bits(result.rgb, reference.rgb));
+                CHECK(result.traversal.stack_overflows == 0);
+                REQUIRE(result.wide_bvh);
+                CHECK(result.wide_bvh->width == scene::wide_bvh_width(structure));
+                if (!first) {
+                    first = std::move(result);
+                    continue;
+                }
+                CHECK(simulated_stats(result) == simulated_stats(*first));
+            }
+            const double bytes = stat(*first, "memory/bvh_nodes_bytes");
+            if (boxes == scene::BvhBoxes::floats)
+                float_bytes = bytes;
+            else
+                CHECK(bytes * 2 == float_bytes);  // half the bytes per node
+        }
+    }
+}
+
 TEST_CASE("every key a cycle-level render registers is documented in docs/statistics.md",
           "[render][docs]") {
     const std::vector<std::regex> documented = documented_stat_patterns();
     REQUIRE(documented.size() > 20);
-    // The finite I-cache's keys exist only with one.
-    timing::ChipConfig finite_icache = tiny();
-    timing::apply_override(finite_icache, "icache.size_bytes=1024");
-    for (const timing::ChipConfig& chip : {tiny(), finite_icache}) {
-        const auto result = render_cornell(render::Engine::timing, chip);
+    // The keys the run registers, each checked.
+    const auto check_documented = [&](const render::RenderResult& result) {
         stats::Registry registry;
         render::register_stats(result, registry);
-        REQUIRE(registry.contains("chip/rays_per_second"));
-        CHECK(registry.contains("chip/icache/misses") == chip.icache.finite());
+        std::set<std::string> keys;
         for (const stats::Entry& e : registry.entries()) {
             INFO(e.name);
             CHECK(std::any_of(documented.begin(), documented.end(),
                               [&](const std::regex& re) { return std::regex_match(e.name, re); }));
+            keys.insert(e.name);
         }
+        CHECK(keys.count("chip/rays_per_second") == 1);
+        return keys;
+    };
+    // The finite I-cache's keys exist only with one.
+    timing::ChipConfig finite_icache = tiny();
+    timing::apply_override(finite_icache, "icache.size_bytes=1024");
+    for (const timing::ChipConfig& chip : {tiny(), finite_icache}) {
+        const auto keys = check_documented(render_cornell(render::Engine::timing, chip));
+        CHECK((keys.count("chip/icache/misses") == 1) == chip.icache.finite());
     }
+    // The wide BVH's keys exist only with one.
+    render::RenderOptions wide;
+    wide.scene = small_cornell();
+    wide.kernel = TPSIM_KERNEL_DIR "/tracer_wide.elf";
+    wide.engine = render::Engine::timing;
+    wide.chip = tiny();
+    wide.chip.tp.local_store_bytes = 2048;
+    CHECK(check_documented(render::render(wide)).count("wide_bvh/nodes") == 1);
 }
 
 namespace {
