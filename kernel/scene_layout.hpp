@@ -30,6 +30,8 @@ constexpr const char* kUsesGridSymbol = "trax_uses_grid";
 /// binary BVH, collapses it to 4 or 8 children per node (render --accel bvh4|bvh8) and lays out
 /// only the wide nodes (AccelRecord kind kAccelWideBvh).
 constexpr const char* kUsesWideBvhSymbol = "trax_uses_wide_bvh";
+/// The same for a kernel that traverses the kd-tree (TRAX_USES_KDTREE).
+constexpr const char* kUsesKdTreeSymbol = "trax_uses_kdtree";
 /// Name of the marker symbol trax.hpp's emitter and random-number functions leave in a kernel's
 /// ELF: the host adds the SceneExtras sections only for such kernels, so the memory image (and
 /// every statistic) of a kernel that reads neither stays as it was before they existed.
@@ -128,7 +130,17 @@ constexpr int32_t kWideStackEntries = 64;
 enum AccelKind : int32_t {
     kAccelGrid = 1,
     kAccelWideBvh = 2,
+    kAccelKdTree = 3,
 };
+
+/// Entries in the kd-tree traversal stack (kernel/kdtree.hpp): one per level, the host builds
+/// no deeper tree (scene::kKdMaxDepth).
+constexpr int32_t kKdStackEntries = 40;
+/// kd-tree nodes are two words: an interior node holds its plane's position (float) and
+/// axis | right child << 2 (axis 0..2; the left child is the next node); a leaf holds the
+/// first of its references and kKdLeaf | count << 2.
+constexpr int32_t kKdNodeWords = 2;
+constexpr uint32_t kKdLeaf = 3;
 
 /// A wide-BVH child reference, the same in both box formats: 0 is no child (a node's children
 /// come first, its empty slots last); > 0 is the word address of an interior child's node; < 0
@@ -163,6 +175,11 @@ constexpr int32_t wide_quantized_boxes_byte(int32_t width) {
 /// number x + resolution[0] * (y + resolution[1] * z). `nodes` holds one word per cell plus one:
 /// cell i's triangles are refs[nodes[i] .. nodes[i + 1]), image triangle indices, every triangle
 /// listed in every cell its bounding box overlaps (so a triangle may appear in many cells).
+///
+/// kd-tree (kAccelKdTree): the bounds are the tree's box; `nodes` holds the nodes
+/// (kKdNodeWords each, count in words, the root first, depth-first), `refs` the leaves'
+/// triangles (image triangle indices, in scene order; a triangle is listed in every leaf its
+/// bounding box reaches).
 ///
 /// Wide BVH (kAccelWideBvh): `width` (4 or 8) children per node, boxes quantized or not; the
 /// bounds are the root's box; `nodes` holds the nodes (count in words, the root first, each

@@ -138,6 +138,13 @@ TRAX_CSR_FUNCTION(trax_tm_size, 0xCC4)
         "trax_uses_wide_bvh:\n  ret\n.size trax_uses_wide_bvh, . - "                               \
         "trax_uses_wide_bvh\n.popsection")
 
+/// Write `TRAX_USES_KDTREE;` at file scope in a kernel that traverses the kd-tree (kernel/
+/// kdtree.hpp): tpsim then builds the kd-tree (trax::layout::kUsesKdTreeSymbol).
+#define TRAX_USES_KDTREE                                                                           \
+    asm(".pushsection .text.trax_uses_kdtree, \"ax\", @progbits\n"                                 \
+        ".globl trax_uses_kdtree\n.type trax_uses_kdtree, @function\n"                             \
+        "trax_uses_kdtree:\n  ret\n.size trax_uses_kdtree, . - trax_uses_kdtree\n.popsection")
+
 namespace trax::detail {
 /// Leaves the marker trax::layout::kUsesExtrasSymbol in the ELF (once per object file: .ifndef;
 /// weak, so objects may share it; kept by the link script). Called by every function that reads
@@ -172,6 +179,7 @@ TRAX_INLINE void set_rand_state(uint32_t state) {
 #define TRAX_USES_BVH static_assert(true)
 #define TRAX_USES_GRID static_assert(true)
 #define TRAX_USES_WIDE_BVH static_assert(true)
+#define TRAX_USES_KDTREE static_assert(true)
 
 namespace trax::native {
 

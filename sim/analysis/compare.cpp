@@ -220,8 +220,9 @@ std::vector<SetupDifference> setup_differences(const std::vector<StatsFile>& run
         return text.empty() ? std::string(kAbsent) : text;
     };
     for (const char* field :
-         {"scene", "kernel", "engine", "accel", "grid_resolution", "grid_density", "bvh_builder",
-          "max_leaf", "bvh_order", "bvh_align_pairs", "bvh_boxes"}) {
+         {"scene", "kernel", "engine", "accel", "grid_resolution", "grid_density",
+          "kdtree_max_depth", "kdtree_max_references", "bvh_builder", "max_leaf", "bvh_order",
+          "bvh_align_pairs", "bvh_boxes"}) {
         std::vector<std::string> values;
         for (const StatsFile& run : runs)
             values.push_back(run_field(run, field));

@@ -186,6 +186,10 @@ std::string run_line(const StatsFile& run) {
                 ? fmt::format("uniform grid, {} cells per triangle", field("grid_density"))
                 : fmt::format("uniform grid, {} cells on the longest axis",
                               field("grid_resolution")));
+    else if (accel == "kdtree")
+        parts.push_back(fmt::format("kd-tree, depth limit {}", field("kdtree_max_depth") == "0"
+                                                                   ? std::string("8 + 1.3 log2 N")
+                                                                   : field("kdtree_max_depth")));
     else if (accel == "none")
         parts.push_back("no acceleration structure");
     else if (accel == "bvh4" || accel == "bvh8")

@@ -36,6 +36,8 @@ struct RenderCommandOptions {
     std::string accel;
     uint32_t grid_resolution = 0;
     double grid_density = scene::GridConfig{}.density;
+    uint32_t kdtree_max_depth = 0;
+    double kdtree_max_references = scene::KdTreeConfig{}.max_references_per_triangle;
     std::vector<std::string> params;
     std::string config;
     std::vector<std::string> overrides;
@@ -87,6 +89,8 @@ int run_render(RenderCommandOptions& o) {
                               .default_kernel));
     options.grid.resolution = o.grid_resolution;
     options.grid.density = o.grid_density;
+    options.kdtree.max_depth = o.kdtree_max_depth;
+    options.kdtree.max_references_per_triangle = o.kdtree_max_references;
     options.params = o.params;
     options.engine = o.native             ? render::Engine::native
                      : o.timing != "none" ? render::Engine::timing
@@ -228,9 +232,9 @@ Command add_render_command(CLI::App& app) {
     command
         ->add_option("--accel", o->accel,
                      "Acceleration structure: bvh2 (binary BVH, kernel tracer), bvh4 or bvh8 "
-                     "(wide BVHs, kernel tracer_wide) or grid (uniform grid, kernel "
-                     "tracer_grid); with --kernel, one the kernel traverses (docs/accel.md) "
-                     "[default: the kernel's]")
+                     "(wide BVHs, kernel tracer_wide), grid (uniform grid, kernel tracer_grid) "
+                     "or kdtree (kernel tracer_kdtree); with --kernel, one the kernel traverses "
+                     "(docs/accel.md) [default: the kernel's]")
         ->check(CLI::IsMember(scene::accel_names()));
     command
         ->add_option("--grid-resolution", o->grid_resolution,
@@ -242,6 +246,17 @@ Command add_render_command(CLI::App& app) {
         ->add_option("--grid-density", o->grid_density,
                      "Uniform grid: cells per triangle (cubic cells) when --grid-resolution is 0")
         ->check(CLI::Range(1.0 / 1024, scene::kGridMaxDensity))
+        ->capture_default_str();
+    command
+        ->add_option("--kdtree-max-depth", o->kdtree_max_depth,
+                     "kd-tree: deepest leaf; 0: 8 + 1.3 log2(triangles), Havran's rule")
+        ->check(whole_number_in(0, scene::kKdMaxDepth))
+        ->capture_default_str();
+    command
+        ->add_option("--kdtree-max-references", o->kdtree_max_references,
+                     "kd-tree: most leaf references per triangle, on average, before the build "
+                     "is refused")
+        ->check(CLI::Range(1.0, 1e6))
         ->capture_default_str();
     command
         ->add_option("-p,--param", o->params,

@@ -129,7 +129,7 @@ std::vector<uint32_t> pair_order(const scene::Bvh& bvh, scene::BvhOrder order) {
 /// the scale is a normal float; biased by 127, as the kernel rebuilds the scale from it.
 uint32_t quantization_exponent(float lo, float hi) {
     const double extent = double(hi) - double(lo);  // exact
-    int e = -126;
+    int e = extent > 0 ? std::max(-126, std::ilogb(extent / 255)) : -126;
     while (std::ldexp(255.0, e) < extent)
         ++e;
     return uint32_t(e + 127);
@@ -283,6 +283,7 @@ MemoryImage build_memory_image(const scene::Scene& scene, Accel accel, uint32_t 
     const scene::Bvh* bvh = accel.bvh;
     const scene::WideBvh* wide = accel.wide_bvh;
     const scene::Grid* grid = accel.grid;
+    const scene::KdTree* kdtree = accel.kdtree;
     const std::vector<uint32_t>* triangle_order = bvh    ? &bvh->triangle_order
                                                   : wide ? &wide->triangle_order
                                                          : nullptr;
@@ -337,7 +338,15 @@ MemoryImage build_memory_image(const scene::Scene& scene, Accel accel, uint32_t 
         put(accel_record.bounds_min, wide->bounds.lo);
         put(accel_record.bounds_max, wide->bounds.hi);
     }
-    const bool has_record = grid != nullptr || wide != nullptr;
+    if (kdtree != nullptr) {
+        accel_record.kind = layout::kAccelKdTree;
+        accel_record.nodes.count =
+            checked_count(kdtree->nodes.size() * layout::kKdNodeWords, "kd-tree node words");
+        accel_record.refs.count = checked_count(kdtree->references.size(), "kd-tree references");
+        put(accel_record.bounds_min, kdtree->bounds.lo);
+        put(accel_record.bounds_max, kdtree->bounds.hi);
+    }
+    const bool has_record = grid != nullptr || wide != nullptr || kdtree != nullptr;
     const uint64_t pixels = uint64_t(scene.width) * scene.height;
     if (pixels > uint64_t(std::numeric_limits<int32_t>::max() / 16))
         throw Error(fmt::format("image {}x{} is too large for the 32-bit memory image", scene.width,
@@ -422,6 +431,22 @@ MemoryImage build_memory_image(const scene::Scene& scene, Accel accel, uint32_t 
         std::memcpy(image.words.data() + accel_record.refs.addr, grid->references.data(),
                     grid->references.size() * 4);
     }
+    if (kdtree != nullptr) {
+        write(image.words, h.accel, accel_record);
+        uint32_t* out = image.words.data() + accel_record.nodes.addr;
+        for (const scene::KdNode& node : kdtree->nodes) {
+            if (node.is_leaf()) {
+                out[0] = node.first;
+                out[1] = layout::kKdLeaf | node.count << 2;
+            } else {
+                std::memcpy(&out[0], &node.split, 4);
+                out[1] = node.axis | node.right_child << 2;
+            }
+            out += layout::kKdNodeWords;
+        }
+        std::memcpy(image.words.data() + accel_record.refs.addr, kdtree->references.data(),
+                    kdtree->references.size() * 4);
+    }
     if (wide != nullptr) {
         write(image.words, h.accel, accel_record);
         const std::vector<uint32_t> nodes =
@@ -462,6 +487,13 @@ MemoryImage build_memory_image(const scene::Scene& scene, Accel accel, uint32_t 
         image.sections.push_back({"grid", 1, sizeof(accel_record), uint64_t(h.accel) * 4});
         image.sections.push_back(section("grid_cells", accel_record.nodes, 1));
         image.sections.push_back(section("grid_refs", accel_record.refs, 1));
+    }
+    if (kdtree != nullptr) {
+        image.sections.push_back({"kdtree", 1, sizeof(accel_record), uint64_t(h.accel) * 4});
+        image.sections.push_back({"kdtree_nodes", uint32_t(kdtree->nodes.size()),
+                                  uint64_t(accel_record.nodes.count) * 4,
+                                  uint64_t(accel_record.nodes.addr) * 4});
+        image.sections.push_back(section("kdtree_refs", accel_record.refs, 1));
     }
     image.sections.push_back(section("framebuffer", h.framebuffer, layout::kPixelWords));
     image.sections.push_back(section("thread_stats", h.thread_stats, layout::kThreadStatsWords));

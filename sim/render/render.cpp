@@ -192,6 +192,7 @@ RenderResult render(const RenderOptions& options) {
     std::optional<scene::Bvh> bvh;
     std::optional<scene::WideBvh> wide_bvh;
     std::optional<scene::Grid> grid;
+    std::optional<scene::KdTree> kdtree;
     if (result.accel == scene::AccelStructure::bvh2 || width != 0) {
         start = std::chrono::steady_clock::now();
         scene::BvhConfig config = options.bvh;
@@ -220,13 +221,23 @@ RenderResult render(const RenderOptions& options) {
         }
         result.grid_seconds = seconds_since(start);
         result.grid = grid->stats;
+    } else if (result.accel == scene::AccelStructure::kdtree) {
+        start = std::chrono::steady_clock::now();
+        try {
+            kdtree = scene::build_kdtree(result.scene.triangles, options.kdtree);
+        } catch (const std::invalid_argument& e) {
+            throw Error(e.what());
+        }
+        result.kdtree_seconds = seconds_since(start);
+        result.kdtree = kdtree->stats;
     }
     result.threads = options.chip.chip.num_tms * options.chip.chip.tps_per_tm;
     const image::Accel accel = bvh ? image::Accel(&*bvh, options.bvh.order, options.bvh.align_pairs)
                                : wide_bvh
                                    ? image::Accel(&*wide_bvh, options.bvh.order, options.bvh.boxes)
-                               : grid ? image::Accel(&*grid)
-                                      : nullptr;
+                               : grid   ? image::Accel(&*grid)
+                               : kdtree ? image::Accel(&*kdtree)
+                                        : nullptr;
     result.image = image::build_memory_image(result.scene, accel, result.threads, {},
                                              kernel.uses_extras() ? std::optional(options.seed)
                                                                   : std::nullopt);

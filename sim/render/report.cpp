@@ -262,6 +262,31 @@ void register_stats(const RenderResult& r, stats::Registry& reg) {
         number(
             "host/grid_seconds", [&r] { return r.grid_seconds; }, "grid build time", "s");
     }
+    if (r.kdtree) {
+        const scene::KdTreeStats& k = *r.kdtree;
+        number(
+            "kdtree/nodes", [&k] { return k.nodes; }, "kd-tree nodes (interior + leaves)");
+        number(
+            "kdtree/leaves", [&k] { return k.leaves; }, "kd-tree leaves");
+        number(
+            "kdtree/empty_leaves", [&k] { return k.empty_leaves; },
+            "kd-tree leaves with no triangle");
+        number(
+            "kdtree/max_depth", [&k] { return k.max_depth; },
+            "edges from the root to the deepest leaf");
+        number(
+            "kdtree/references", [&k] { return k.references; },
+            "leaf entries (a triangle in k leaves counts k)");
+        number(
+            "kdtree/references_per_triangle",
+            [&k, &r] { return double(k.references) / double(r.scene.triangles.size()); },
+            "leaves a triangle is listed in, on average");
+        number(
+            "kdtree/max_leaf_triangles", [&k] { return k.max_leaf_triangles; },
+            "most triangles listed in one leaf");
+        number(
+            "host/kdtree_seconds", [&r] { return r.kdtree_seconds; }, "kd-tree build time", "s");
+    }
 
     const image::TraversalTotals& t = r.traversal;
     const auto per_ray = [&t](uint64_t count) {
@@ -448,6 +473,15 @@ void print_summary(const RenderOptions& options, const RenderResult& r,
                    100.0 * double(g.empty_cells) / double(g.cells), g.max_cell_triangles,
                    r.grid_seconds);
     }
+    if (r.kdtree) {
+        const scene::KdTreeStats& k = *r.kdtree;
+        fmt::print(out,
+                   "kdtree   {} nodes, {} leaves ({} empty), depth {} (limit {}), {} references "
+                   "({:.2f} per triangle), at most {} in a leaf, built in {:.3f} s\n",
+                   k.nodes, k.leaves, k.empty_leaves, k.max_depth, k.depth_limit, k.references,
+                   double(k.references) / double(r.scene.triangles.size()), k.max_leaf_triangles,
+                   r.kdtree_seconds);
+    }
     if (r.traversal.rays() > 0) {
         const double rays = double(r.traversal.rays());
         fmt::print(out, "rays     {} ({} primary, {} shadow): {:.1f} {}, {:.1f} triangles per ray",
@@ -533,6 +567,10 @@ nlohmann::ordered_json stats_document(const RenderOptions& options, const Render
     if (r.grid) {
         run["grid_resolution"] = options.grid.resolution;
         run["grid_density"] = options.grid.density;
+    }
+    if (r.kdtree) {
+        run["kdtree_max_depth"] = options.kdtree.max_depth;
+        run["kdtree_max_references"] = options.kdtree.max_references_per_triangle;
     }
     run["bvh_builder"] = scene::to_string(options.bvh.builder);
     run["max_leaf"] = options.bvh.max_leaf_size;

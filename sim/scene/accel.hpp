@@ -1,7 +1,7 @@
 // The acceleration structures tpsim builds for a kernel: which one follows from the marker the
-// kernel's ELF defines (TRAX_USES_BVH, TRAX_USES_WIDE_BVH, TRAX_USES_GRID); `render --accel`
-// and the sweep key `accel` name one (for a marker that several share, the one to build) and
-// pick its default kernel.
+// kernel's ELF defines (TRAX_USES_BVH, TRAX_USES_WIDE_BVH, TRAX_USES_GRID, TRAX_USES_KDTREE);
+// `render --accel` and the sweep key `accel` name one (for a marker that several share, the one to
+// build) and pick its default kernel.
 #pragma once
 #include <array>
 #include <optional>
@@ -14,11 +14,12 @@
 namespace tpsim::scene {
 
 enum class AccelStructure {
-    none,  ///< brute force: the kernel tests every triangle
-    bvh2,  ///< the binary BVH (sim/scene/bvh.hpp)
-    bvh4,  ///< the binary BVH collapsed to 4 children per node (sim/scene/wide_bvh.hpp)
-    bvh8,  ///< ... to 8 children per node
-    grid,  ///< the uniform grid (sim/scene/grid.hpp)
+    none,    ///< brute force: the kernel tests every triangle
+    bvh2,    ///< the binary BVH (sim/scene/bvh.hpp)
+    bvh4,    ///< the binary BVH collapsed to 4 children per node (sim/scene/wide_bvh.hpp)
+    bvh8,    ///< ... to 8 children per node
+    grid,    ///< the uniform grid (sim/scene/grid.hpp)
+    kdtree,  ///< the kd-tree (sim/scene/kdtree.hpp)
 };
 
 struct AccelInfo {
@@ -39,6 +40,8 @@ constexpr std::array kAccelStructures = {
               "the 8-wide BVH"},
     AccelInfo{AccelStructure::grid, "grid", "tracer_grid", trax::layout::kUsesGridSymbol,
               "the uniform grid"},
+    AccelInfo{AccelStructure::kdtree, "kdtree", "tracer_kdtree", trax::layout::kUsesKdTreeSymbol,
+              "the kd-tree"},
 };
 
 constexpr AccelInfo accel_info(AccelStructure structure) {

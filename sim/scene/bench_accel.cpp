@@ -1,8 +1,8 @@
 // bench_accel [--threads N] [scene-or-mesh ...]: loads each scene and builds each acceleration
 // structure: the BVH with both SAH builders (build time as wall clock and the process's CPU
 // time, all threads; node count, depth, SAH cost), the BVH's image layout in each node order,
-// its collapse into the 4- and 8-wide BVHs and their layout in both box formats, and the
-// uniform grid by the density rule. Defaults to the bunny and the stress scene, and to
+// its collapse into the 4- and 8-wide BVHs and their layout in both box formats, the uniform
+// grid by the density rule and the kd-tree. Defaults to the bunny and the stress scene, and to
 // oneTBB's default thread count (the host's cores).
 #include <chrono>
 #include <ctime>
@@ -18,6 +18,7 @@
 #include "sim/image/memory_image.hpp"
 #include "sim/scene/bvh.hpp"
 #include "sim/scene/grid.hpp"
+#include "sim/scene/kdtree.hpp"
 #include "sim/scene/load_scene.hpp"
 #include "sim/scene/wide_bvh.hpp"
 
@@ -88,8 +89,8 @@ int main(int argc, char** argv) {
                 for (BvhBoxes boxes : kBvhBoxes) {
                     cpu_start = cpu_seconds();
                     start = std::chrono::steady_clock::now();
-                    const auto words = tpsim::image::compile_wide_bvh(
-                        wide, BvhOrder::breadth_first, boxes, 0);
+                    const auto words =
+                        tpsim::image::compile_wide_bvh(wide, BvhOrder::breadth_first, boxes, 0);
                     fmt::print("{:<14} {:<34} {:>9.1f} {:>9.1f} {:>10.1f} M {:>10}\n", scene.name,
                                fmt::format("bvh{} layout, {} boxes", width, to_string(boxes)),
                                seconds_since(start) * 1e3, (cpu_seconds() - cpu_start) * 1e3,
@@ -106,6 +107,14 @@ int main(int argc, char** argv) {
                 fmt::format("grid {}x{}x{}", g.resolution[0], g.resolution[1], g.resolution[2]),
                 wall * 1e3, cpu * 1e3, double(g.bytes()) / (1 << 20),
                 double(grid.references.size()) / double(scene.triangles.size()));
+            const double kd_cpu_start = cpu_seconds();
+            const auto kd_start = std::chrono::steady_clock::now();
+            const KdTree kdtree = build_kdtree(scene.triangles);
+            const KdTreeStats& k = kdtree.stats;
+            fmt::print("{:<14} {:<34} {:>9.1f} {:>9.1f} {:>10.1f} M {:>10.2f}\n", scene.name,
+                       fmt::format("kdtree depth {}", k.max_depth), seconds_since(kd_start) * 1e3,
+                       (cpu_seconds() - kd_cpu_start) * 1e3, double(k.bytes()) / (1 << 20),
+                       double(k.references) / double(scene.triangles.size()));
         }
     } catch (const std::exception& e) {
         fmt::print(stderr, "bench_accel: {}\n", e.what());

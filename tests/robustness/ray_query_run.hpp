@@ -1,7 +1,8 @@
 // The harness both robustness tests share: every acceleration structure (and box format) built
 // for a mesh, and its ray_query kernel (ray_query through the BVH, ray_query_wide through the
-// wide BVHs, ray_query_grid through the uniform grid) over a batch of rays, on the functional
-// simulator and on the native twin, whose results must agree bit for bit.
+// wide BVHs, ray_query_grid through the uniform grid, ray_query_kdtree through the kd-tree) over a
+// batch of rays, on the functional simulator and on the native twin, whose results must agree bit
+// for bit.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -41,6 +42,7 @@ inline constexpr AccelVariant kAccelVariants[] = {
     {scene::AccelStructure::bvh8},
     {scene::AccelStructure::bvh8, scene::BvhBoxes::quantized},
     {scene::AccelStructure::grid},
+    {scene::AccelStructure::kdtree},
 };
 
 /// A structure built for a mesh as render() builds it (the BVH with the kernels' depth limit).
@@ -49,10 +51,15 @@ struct BuiltAccel {
     std::optional<scene::Bvh> bvh;
     std::optional<scene::WideBvh> wide;
     std::optional<scene::Grid> grid;
+    std::optional<scene::KdTree> kdtree;
 
     BuiltAccel(const std::vector<scene::Triangle>& mesh, AccelVariant v) : variant(v) {
         if (v.structure == scene::AccelStructure::grid) {
             grid = scene::build_grid(mesh);
+            return;
+        }
+        if (v.structure == scene::AccelStructure::kdtree) {
+            kdtree = scene::build_kdtree(mesh);
             return;
         }
         scene::BvhConfig config;
@@ -65,6 +72,7 @@ struct BuiltAccel {
     }
     image::Accel accel() const {
         if (grid) return &*grid;
+        if (kdtree) return &*kdtree;
         if (wide) return {&*wide, scene::BvhOrder::breadth_first, variant.boxes};
         return &*bvh;
     }
@@ -79,11 +87,15 @@ struct BuiltAccel {
     uint64_t most_nodes() const {
         if (bvh) return bvh->nodes.size();
         if (wide) return 1 + uint64_t(wide->nodes.size()) * wide->stats.width;
+        if (kdtree) return kdtree->nodes.size();
         return uint64_t(grid->stats.resolution[0]) + grid->stats.resolution[1] +
                grid->stats.resolution[2] - 2;
     }
     const char* kernel() const {
-        return grid ? "ray_query_grid.elf" : wide ? "ray_query_wide.elf" : "ray_query.elf";
+        return grid     ? "ray_query_grid.elf"
+               : wide   ? "ray_query_wide.elf"
+               : kdtree ? "ray_query_kdtree.elf"
+                        : "ray_query.elf";
     }
 };
 

@@ -264,7 +264,8 @@ TEST_CASE("robustness: axis-aligned rays with the origin on BVH box and grid cel
     EACH_STRUCTURE;
     // A 4x4 grid per face: leaf boxes have planes at multiples of 1/4 inside the cube.
     const Mesh cube = grid_cube(4);
-    // The planes the structure's traversal computes distances to: node boxes' or cell faces'.
+    // The planes the structure's traversal computes distances to: node boxes', cell faces or
+    // split planes.
     std::array<std::vector<float>, 3> planes;
     if (variant.structure == AccelStructure::grid) {
         const scene::Grid grid = scene::build_grid(cube);
@@ -275,6 +276,9 @@ TEST_CASE("robustness: axis-aligned rays with the origin on BVH box and grid cel
                     (grid.hi[axis] - grid.lo[axis]) / float(grid.stats.resolution[size_t(axis)]);
                 planes[size_t(axis)].push_back(grid.lo[axis] + float(c) * cell);
             }
+    } else if (variant.structure == AccelStructure::kdtree) {
+        for (const scene::KdNode& node : scene::build_kdtree(cube).nodes)
+            if (!node.is_leaf()) planes[node.axis].push_back(node.split);
     } else if (scene::wide_bvh_width(variant.structure) != 0) {
         // The child boxes as the kernel decodes them (quantized ones lie on their own grid).
         const test::BuiltAccel built(cube, variant);

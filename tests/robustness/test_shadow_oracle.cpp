@@ -506,7 +506,8 @@ TEST_CASE("shadow oracle: no holes, false shadows or leaks on the corpus, agains
     const test::AccelVariant variants[] = {{AccelStructure::bvh2},
                                            {AccelStructure::bvh4, scene::BvhBoxes::quantized},
                                            {AccelStructure::bvh8},
-                                           {AccelStructure::grid}};
+                                           {AccelStructure::grid},
+                                           {AccelStructure::kdtree}};
     constexpr size_t kVariants = std::size(variants);
     size_t hit_differs = 0, distance_differs = 0, shadow_differs = 0, clear_shadow_differs = 0,
            queries = 0;

@@ -228,7 +228,7 @@ l2.size_bytes = [4096, 8192]
     CHECK_THROWS_WITH(read_plan(dir), Catch::Contains("is not a sweep's results directory"));
     std::ofstream(plan_path(dir / "results")) << "{\"format\": \"tpsim-sweep\", \"version\": 7}";
     CHECK_THROWS_WITH(read_plan(dir / "results"),
-                      Catch::Contains("written by plan version 7; this tpsim reads version 1"));
+                      Catch::Contains("written by plan version 7; this tpsim reads version 2"));
 }
 
 TEST_CASE("sweep: finished, pending and failed jobs; collect reads the statistics files",

@@ -221,6 +221,35 @@ TEST_CASE("every key a cycle-level render registers is documented in docs/statis
     wide.chip = tiny();
     wide.chip.tp.local_store_bytes = 2048;
     CHECK(check_documented(render::render(wide)).count("wide_bvh/nodes") == 1);
+    // And the kd-tree's.
+    render::RenderOptions kdtree = wide;
+    kdtree.kernel = TPSIM_KERNEL_DIR "/tracer_kdtree.elf";
+    CHECK(check_documented(render::render(kdtree)).count("kdtree/references") == 1);
+}
+
+TEST_CASE("The kd-tree renders the binary BVH's image, the same on one and on two host threads",
+          "[render][invariance][kdtree]") {
+    const auto reference = render_cornell(render::Engine::timing, tiny());
+    std::optional<render::RenderResult> first;
+    for (uint32_t host_threads : {1u, 2u}) {
+        core::set_host_threads(host_threads);
+        render::RenderOptions options;
+        options.scene = small_cornell();
+        options.kernel = TPSIM_KERNEL_DIR "/tracer_kdtree.elf";
+        options.engine = render::Engine::timing;
+        options.chip = tiny();
+        options.chip.tp.local_store_bytes = 2048;  // the 40-entry stack needs more than 1 KiB
+        options.chip.chip.num_tms = 2;             // one per host thread
+        auto result = render::render(options);
+        CHECK(same_bits(result.rgb, reference.rgb));
+        CHECK(result.traversal.stack_overflows == 0);
+        REQUIRE(result.kdtree);
+        CHECK(result.kdtree->references >= result.scene.triangles.size());
+        if (!first)
+            first = std::move(result);
+        else
+            CHECK(simulated_stats(result) == simulated_stats(*first));
+    }
 }
 
 namespace {

@@ -1,0 +1,129 @@
+// The kd-tree builder: every triangle is in every leaf its box reaches, the nodes are the
+// depth-first tree the kernel walks, the build is the same on any number of threads, and the
+// limits are enforced with a clear message.
+#include <algorithm>
+#include <random>
+#include <vector>
+
+#include <catch2/catch.hpp>
+#include <oneapi/tbb/global_control.h>
+
+#include "sim/scene/kdtree.hpp"
+
+using namespace tpsim::scene;
+
+namespace {
+
+std::vector<Triangle> soup(uint32_t count, uint32_t seed, float size) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> position(-10.f, 10.f), offset(-size, size);
+    std::vector<Triangle> triangles;
+    for (uint32_t i = 0; i < count; ++i) {
+        const glm::vec3 c(position(rng), position(rng), position(rng));
+        const auto corner = [&] { return c + glm::vec3(offset(rng), offset(rng), offset(rng)); };
+        triangles.push_back({corner(), corner(), corner(), 0});
+    }
+    return triangles;
+}
+
+/// Walks the tree with each node's cell; calls leaf(cell, node) for every leaf.
+template <class Leaf> void walk(const KdTree& tree, Leaf leaf) {
+    struct Item {
+        uint32_t node;
+        Aabb cell;
+        uint32_t depth;
+    };
+    std::vector<Item> pending{{0, tree.bounds, 0}};
+    while (!pending.empty()) {
+        const Item item = pending.back();
+        pending.pop_back();
+        const KdNode& node = tree.nodes.at(item.node);
+        if (node.is_leaf()) {
+            leaf(item.cell, node, item.depth);
+            continue;
+        }
+        REQUIRE(node.axis < 3);
+        REQUIRE(node.right_child > item.node + 1);
+        CHECK(node.split > item.cell.lo[node.axis]);
+        CHECK(node.split < item.cell.hi[node.axis]);
+        Aabb below = item.cell, above = item.cell;
+        below.hi[node.axis] = node.split;
+        above.lo[node.axis] = node.split;
+        pending.push_back({node.right_child, above, item.depth + 1});
+        pending.push_back({item.node + 1, below, item.depth + 1});
+    }
+}
+
+}  // namespace
+
+TEST_CASE("Every triangle is in every kd-tree leaf its bounding box reaches", "[kdtree]") {
+    const float size = GENERATE(0.3f, 3.f);
+    const auto triangles = soup(800, 5, size);
+    const KdTree tree = build_kdtree(triangles);
+    for (const Triangle& t : triangles)
+        for (const glm::vec3& v : {t.v0, t.v1, t.v2})
+            CHECK(glm::all(glm::lessThan(tree.bounds.lo, v) && glm::lessThan(v, tree.bounds.hi)));
+    uint32_t leaves = 0, empty = 0, deepest = 0;
+    uint64_t references = 0;
+    walk(tree, [&](const Aabb& cell, const KdNode& leaf, uint32_t depth) {
+        ++leaves;
+        empty += leaf.count == 0;
+        references += leaf.count;
+        deepest = std::max(deepest, depth);
+        REQUIRE(leaf.first + leaf.count <= tree.references.size());
+        const auto begin = tree.references.begin() + leaf.first;
+        const std::vector<uint32_t> listed(begin, begin + leaf.count);
+        for (uint32_t i = 0; i < triangles.size(); ++i) {
+            const Triangle& t = triangles[i];
+            const glm::vec3 lo = glm::min(t.v0, glm::min(t.v1, t.v2));
+            const glm::vec3 hi = glm::max(t.v0, glm::max(t.v1, t.v2));
+            // The box reaches into the cell (touching a face counts: the margin takes it).
+            if (glm::all(glm::lessThanEqual(lo, cell.hi) && glm::lessThanEqual(cell.lo, hi)))
+                CHECK(std::count(listed.begin(), listed.end(), i) == 1);
+        }
+    });
+    const KdTreeStats& s = tree.stats;
+    CHECK(s.nodes == tree.nodes.size());
+    CHECK(s.leaves == leaves);
+    CHECK(s.nodes == 2 * leaves - 1);
+    CHECK(s.empty_leaves == empty);
+    CHECK(s.references == references);
+    CHECK(s.references == tree.references.size());
+    CHECK(s.references >= triangles.size());
+    CHECK(s.max_depth == deepest);
+    CHECK(s.max_depth <= s.depth_limit);
+    CHECK(s.depth_limit == uint32_t(8 + 1.3 * std::log2(800.0) + 0.5));
+    CHECK(s.nodes > 100);  // the SAH split the soup
+}
+
+TEST_CASE("The kd-tree is the same on one thread and on many", "[kdtree]") {
+    const auto triangles = soup(20000, 9, 0.5f);
+    const KdTree many = build_kdtree(triangles);
+    const tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+    const KdTree single = build_kdtree(triangles);
+    REQUIRE(single.nodes.size() == many.nodes.size());
+    for (size_t i = 0; i < many.nodes.size(); ++i) {
+        const KdNode &a = many.nodes[i], &b = single.nodes[i];
+        CHECK((a.axis == b.axis && a.split == b.split && a.right_child == b.right_child &&
+               a.first == b.first && a.count == b.count));
+    }
+    CHECK(single.references == many.references);
+}
+
+TEST_CASE("kd-tree limits: depth, references per triangle, bad input", "[kdtree]") {
+    const auto triangles = soup(500, 2, 4.f);
+    KdTreeConfig shallow;
+    shallow.max_depth = 3;
+    CHECK(build_kdtree(triangles, shallow).stats.max_depth <= 3);
+    KdTreeConfig deep;
+    deep.max_depth = kKdMaxDepth + 1;
+    CHECK_THROWS_WITH(build_kdtree(triangles, deep), "kd-tree: max_depth must be in 1..40, got 41");
+    KdTreeConfig tight;
+    tight.max_references_per_triangle = 1.5;
+    CHECK_THROWS_WITH(build_kdtree(triangles, tight),
+                      Catch::StartsWith("kd-tree: more than 750 leaf references, 1.5 per "
+                                        "triangle, the limit"));
+    CHECK_THROWS_WITH(build_kdtree({}), "kd-tree: the scene has no triangles");
+    std::vector<Triangle> far = {{{0, 0, 0}, {1, 0, 0}, {0, 1e19f, 0}, 0}};
+    CHECK_THROWS_WITH(build_kdtree(far), "kd-tree: a vertex is beyond +-1e18 (or NaN)");
+}
