@@ -176,13 +176,20 @@ RenderResult render(const RenderOptions& options) {
         !warning.empty() && options.on_warning)
         options.on_warning(warning);
     result.accel = kernel.accel();
-    if (options.accel && !kernel.traverses(*options.accel))
+    if (options.accel && !kernel.traverses(*options.accel)) {
+        // Every structure the kernel's marker serves (bvh4 and bvh8 share one).
+        std::vector<std::string> traversed;
+        for (const scene::AccelInfo& info : scene::kAccelStructures)
+            if (kernel.traverses(info.structure)) traversed.emplace_back(info.description);
         throw Error(fmt::format(
             "--accel {} asks for {} but kernel '{}' traverses {}; give a kernel that traverses "
             "it (e.g. --kernel {}) or leave --accel out",
             scene::to_string(*options.accel), scene::accel_info(*options.accel).description,
-            kernel.elf.filename().string(), scene::accel_info(result.accel).description,
+            kernel.elf.filename().string(),
+            traversed.empty() ? std::string(scene::accel_info(result.accel).description)
+                              : fmt::format("{}", fmt::join(traversed, " or ")),
             scene::accel_info(*options.accel).default_kernel));
+    }
     if (options.accel) result.accel = *options.accel;
     const uint32_t width = scene::wide_bvh_width(result.accel);
     if (options.bvh.boxes == scene::BvhBoxes::quantized && width == 0)
