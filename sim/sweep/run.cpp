@@ -49,6 +49,8 @@ render::RenderOptions render_options(const JobRun& run) {
     if (!run.accel.empty()) options.accel = scene::find_accel(run.accel)->structure;
     options.grid.resolution = run.grid_resolution;
     options.grid.density = run.grid_density;
+    options.kdtree.max_depth = run.kdtree_max_depth;
+    options.kdtree.max_references_per_triangle = run.kdtree_max_references;
     options.image_width = run.width;
     options.image_height = run.height;
     options.samples_per_pixel = run.spp;

@@ -25,9 +25,11 @@ struct JobRun {
     std::filesystem::path kernel;
     /// The acceleration structure asked for (scene::kAccelStructures' names); "": the kernel's.
     std::string accel;
-    uint32_t grid_resolution = 0;  ///< scene::GridConfig::resolution
-    double grid_density = 4.0;     ///< scene::GridConfig::density
-    std::string bvh = "sweep";     ///< BVH builder: sweep, binned or median
+    uint32_t grid_resolution = 0;       ///< scene::GridConfig::resolution
+    double grid_density = 4.0;          ///< scene::GridConfig::density
+    uint32_t kdtree_max_depth = 0;      ///< scene::KdTreeConfig::max_depth
+    double kdtree_max_references = 64;  ///< scene::KdTreeConfig::max_references_per_triangle
+    std::string bvh = "sweep";          ///< BVH builder: sweep, binned or median
     uint32_t max_leaf = 8;
     std::string bvh_order = "breadth-first";  ///< scene::BvhOrder, as to_string names it
     bool bvh_align_pairs = false;             ///< scene::BvhConfig::align_pairs
@@ -76,10 +78,24 @@ struct Sweep {
 using KernelResolver = std::function<std::filesystem::path(const std::string&)>;
 
 /// The settings a sweep file may name besides chip configuration keys.
-inline constexpr const char* kRunSettings[] = {
-    "scene",  "kernel",   "config",    "accel",           "grid_resolution", "grid_density",
-    "bvh",    "max_leaf", "bvh_order", "bvh_align_pairs", "bvh_boxes",       "width",
-    "height", "spp",      "seed",      "timing"};
+inline constexpr const char* kRunSettings[] = {"scene",
+                                               "kernel",
+                                               "config",
+                                               "accel",
+                                               "grid_resolution",
+                                               "grid_density",
+                                               "kdtree_max_depth",
+                                               "kdtree_max_references",
+                                               "bvh",
+                                               "max_leaf",
+                                               "bvh_order",
+                                               "bvh_align_pairs",
+                                               "bvh_boxes",
+                                               "width",
+                                               "height",
+                                               "spp",
+                                               "seed",
+                                               "timing"};
 
 /// Reads, checks and expands a sweep file. Throws tpsim::Error with one line naming
 /// file:line for anything wrong (unknown key, bad value, missing scene, empty axis, zip groups

@@ -13,6 +13,7 @@
 #include "sim/scene/accel.hpp"
 #include "sim/scene/bvh.hpp"
 #include "sim/scene/grid.hpp"
+#include "sim/scene/kdtree.hpp"
 #include "sim/sweep/sweep.hpp"
 
 namespace tpsim::sweep {
@@ -257,6 +258,10 @@ private:
             run.grid_resolution = uint32_t(integer(name, v, 0, scene::kGridMaxResolution));
         } else if (name == "grid_density") {
             run.grid_density = number(name, v, 1.0 / 1024, scene::kGridMaxDensity);
+        } else if (name == "kdtree_max_depth") {
+            run.kdtree_max_depth = uint32_t(integer(name, v, 0, scene::kKdMaxDepth));
+        } else if (name == "kdtree_max_references") {
+            run.kdtree_max_references = number(name, v, 1.0, 1e6);
         } else if (name == "bvh") {
             run.bvh = one_of(name, v, scene::bvh_builder_names());
         } else if (name == "bvh_order") {
@@ -499,6 +504,8 @@ void write_plan(const Sweep& sweep, const std::filesystem::path& dir) {
                           {"accel", r.accel},
                           {"grid_resolution", r.grid_resolution},
                           {"grid_density", r.grid_density},
+                          {"kdtree_max_depth", r.kdtree_max_depth},
+                          {"kdtree_max_references", r.kdtree_max_references},
                           {"bvh", r.bvh},
                           {"max_leaf", r.max_leaf},
                           {"bvh_order", r.bvh_order},
@@ -569,6 +576,8 @@ Sweep read_plan(const std::filesystem::path& dir) {
             job.run.accel = r.at("accel").get<std::string>();
             job.run.grid_resolution = r.at("grid_resolution").get<uint32_t>();
             job.run.grid_density = r.at("grid_density").get<double>();
+            job.run.kdtree_max_depth = r.at("kdtree_max_depth").get<uint32_t>();
+            job.run.kdtree_max_references = r.at("kdtree_max_references").get<double>();
             job.run.bvh = r.at("bvh").get<std::string>();
             job.run.max_leaf = r.at("max_leaf").get<uint32_t>();
             job.run.bvh_order = r.at("bvh_order").get<std::string>();

@@ -154,8 +154,9 @@ TEST_CASE("sweep: bad sweep files are one line naming file:line", "[sweep]") {
     CHECK(error_of(dir, "scene = [\"scenes/a.toml\"\n").starts_with(file + ":"));
     CHECK(error_of(dir, "scene = \"scenes/a.toml\"\nl1.size_bites = [1024]\n") ==
           file + ":2: unknown setting 'l1.size_bites': give a run setting (scene, kernel, "
-                 "config, accel, grid_resolution, grid_density, bvh, max_leaf, bvh_order, "
-                 "bvh_align_pairs, bvh_boxes, width, height, spp, seed, timing), a chip "
+                 "config, accel, grid_resolution, grid_density, kdtree_max_depth, "
+                 "kdtree_max_references, bvh, max_leaf, bvh_order, bvh_align_pairs, bvh_boxes, "
+                 "width, height, spp, seed, timing), a chip "
                  "configuration key such as l1.size_bytes (configs/trax.toml lists them), or "
                  "zip");
     CHECK(error_of(dir, "scene = \"scenes/a.toml\"\nbvh = []\n") ==
