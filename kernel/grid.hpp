@@ -50,14 +50,7 @@ struct GridTraversal {
         const float d[3] = {dir.x, dir.y, dir.z};
         const float inv[3] = {inverse.x, inverse.y, inverse.z};
         const float box_lo[3] = {lo.x, lo.y, lo.z}, box_hi[3] = {hi.x, hi.y, hi.z};
-        for (int axis = 0; axis < 3; ++axis) {
-            const float t0 = (box_lo[axis] - o[axis]) * inv[axis];
-            const float t1 = (box_hi[axis] - o[axis]) * inv[axis];
-            const float near = t0 < t1 ? t0 : t1, far = t0 < t1 ? t1 : t0;
-            if (near > t_enter) t_enter = near;  // NaN (origin on a face, d = 0): no clip
-            if (far < t_leave) t_leave = far;
-        }
-        if (!(t_enter <= t_leave)) return hit;
+        if (!clip_to_box(o, inv, box_lo, box_hi, t_enter, t_leave)) return hit;
 
         const ShearedRay r = shear(origin, dir);
         const float sc[3] = {scale.x, scale.y, scale.z};

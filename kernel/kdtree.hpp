@@ -33,16 +33,9 @@ struct KdTreeTraversal {
         const float d[3] = {dir.x, dir.y, dir.z};
         const float inv[3] = {1.0f / dir.x, 1.0f / dir.y, 1.0f / dir.z};
         const float box_lo[3] = {lo.x, lo.y, lo.z}, box_hi[3] = {hi.x, hi.y, hi.z};
-        // The segment inside the box, [t_near, t_far], as the grid clips it.
+        // The segment inside the box, [t_near, t_far].
         float t_near = 0.0f, t_far = t_max;
-        for (int axis = 0; axis < 3; ++axis) {
-            const float t0 = (box_lo[axis] - o[axis]) * inv[axis];
-            const float t1 = (box_hi[axis] - o[axis]) * inv[axis];
-            const float near = t0 < t1 ? t0 : t1, far = t0 < t1 ? t1 : t0;
-            if (near > t_near) t_near = near;  // NaN (origin on a face, d = 0): no clip
-            if (far < t_far) t_far = far;
-        }
-        if (!(t_near <= t_far)) return hit;
+        if (!clip_to_box(o, inv, box_lo, box_hi, t_near, t_far)) return hit;
         const ShearedRay r = shear(origin, dir);
         int stack_node[kKdStackEntries];
         float stack_near[kKdStackEntries], stack_far[kKdStackEntries];

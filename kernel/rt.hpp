@@ -285,6 +285,22 @@ template <class Box>
     return entry <= exit ? entry : t_far + 1.0f + trax_abs(t_far);
 }
 
+/// Clips the segment [t_enter, t_leave] of the ray with origin `o` and reciprocal direction
+/// `inv` to the box [lo, hi], for structures that clip the ray once and pad their box rather
+/// than widen the exit (sim/scene/grid.hpp, kdtree.hpp). A NaN distance (an axis-parallel ray
+/// whose origin lies on a face) never clips. Returns whether any of the segment is left.
+[[gnu::always_inline]] inline bool clip_to_box(const float* o, const float* inv, const float* lo,
+                                               const float* hi, float& t_enter, float& t_leave) {
+    for (int axis = 0; axis < 3; ++axis) {
+        const float t0 = (lo[axis] - o[axis]) * inv[axis];
+        const float t1 = (hi[axis] - o[axis]) * inv[axis];
+        const float near = t0 < t1 ? t0 : t1, far = t0 < t1 ? t1 : t0;
+        if (near > t_enter) t_enter = near;  // NaN compares false: no clip
+        if (far < t_leave) t_leave = far;
+    }
+    return t_enter <= t_leave;
+}
+
 /// The box of the BVH node at word address `node` (scene_layout.hpp BvhNode), loaded as the
 /// slab test reads it.
 struct NodeBox {
