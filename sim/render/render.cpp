@@ -219,23 +219,27 @@ RenderResult render(const RenderOptions& options) {
                     scene::accel_info(result.accel).description, wide_bvh->stats.worst_stack,
                     trax::layout::kWideStackEntries));
         }
-    } else if (result.accel == scene::AccelStructure::grid) {
-        start = std::chrono::steady_clock::now();
+    }
+    // Builds a structure, timed into `seconds`; the builder's std::invalid_argument (a scene or
+    // option it cannot build from) becomes the run's one-line error.
+    const auto timed_build = [](double& seconds, auto build) {
+        const auto begin = std::chrono::steady_clock::now();
         try {
-            grid = scene::build_grid(result.scene.triangles, options.grid);
+            auto built = build();
+            seconds = seconds_since(begin);
+            return built;
         } catch (const std::invalid_argument& e) {
             throw Error(e.what());
         }
-        result.grid_seconds = seconds_since(start);
+    };
+    if (result.accel == scene::AccelStructure::grid) {
+        grid = timed_build(result.grid_seconds,
+                           [&] { return scene::build_grid(result.scene.triangles, options.grid); });
         result.grid = grid->stats;
     } else if (result.accel == scene::AccelStructure::kdtree) {
-        start = std::chrono::steady_clock::now();
-        try {
-            kdtree = scene::build_kdtree(result.scene.triangles, options.kdtree);
-        } catch (const std::invalid_argument& e) {
-            throw Error(e.what());
-        }
-        result.kdtree_seconds = seconds_since(start);
+        kdtree = timed_build(result.kdtree_seconds, [&] {
+            return scene::build_kdtree(result.scene.triangles, options.kdtree);
+        });
         result.kdtree = kdtree->stats;
     }
     result.threads = options.chip.chip.num_tms * options.chip.chip.tps_per_tm;

@@ -43,17 +43,31 @@ const char* to_string(BvhBuilder builder) {
                                           : "median";
 }
 
-std::vector<std::string> bvh_builder_names() {
+namespace {
+
+/// The names of every value in `all` (to_string), and the value a name names.
+template <class Enum, size_t N> std::vector<std::string> names_of(const Enum (&all)[N]) {
     std::vector<std::string> names;
-    for (BvhBuilder builder : kBvhBuilders)
-        names.emplace_back(to_string(builder));
+    for (Enum value : all)
+        names.emplace_back(to_string(value));
     return names;
 }
 
-std::optional<BvhBuilder> find_bvh_builder(std::string_view name) {
-    for (BvhBuilder builder : kBvhBuilders)
-        if (name == to_string(builder)) return builder;
+template <class Enum, size_t N>
+std::optional<Enum> find_by_name(const Enum (&all)[N], std::string_view name) {
+    for (Enum value : all)
+        if (name == to_string(value)) return value;
     return std::nullopt;
+}
+
+}  // namespace
+
+std::vector<std::string> bvh_builder_names() {
+    return names_of(kBvhBuilders);
+}
+
+std::optional<BvhBuilder> find_bvh_builder(std::string_view name) {
+    return find_by_name(kBvhBuilders, name);
 }
 
 const char* to_string(BvhOrder order) {
@@ -63,16 +77,11 @@ const char* to_string(BvhOrder order) {
 }
 
 std::vector<std::string> bvh_order_names() {
-    std::vector<std::string> names;
-    for (BvhOrder order : kBvhOrders)
-        names.emplace_back(to_string(order));
-    return names;
+    return names_of(kBvhOrders);
 }
 
 std::optional<BvhOrder> find_bvh_order(std::string_view name) {
-    for (BvhOrder order : kBvhOrders)
-        if (name == to_string(order)) return order;
-    return std::nullopt;
+    return find_by_name(kBvhOrders, name);
 }
 
 const char* to_string(BvhBoxes boxes) {
@@ -80,16 +89,11 @@ const char* to_string(BvhBoxes boxes) {
 }
 
 std::vector<std::string> bvh_boxes_names() {
-    std::vector<std::string> names;
-    for (BvhBoxes boxes : kBvhBoxes)
-        names.emplace_back(to_string(boxes));
-    return names;
+    return names_of(kBvhBoxes);
 }
 
 std::optional<BvhBoxes> find_bvh_boxes(std::string_view name) {
-    for (BvhBoxes boxes : kBvhBoxes)
-        if (name == to_string(boxes)) return boxes;
-    return std::nullopt;
+    return find_by_name(kBvhBoxes, name);
 }
 
 namespace {

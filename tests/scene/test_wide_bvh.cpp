@@ -2,6 +2,7 @@
 // compiler lays the tree out as scene_layout.hpp documents, in every node order and both box
 // formats, with quantized boxes that contain the float ones.
 #include <algorithm>
+#include <array>
 #include <map>
 #include <random>
 #include <set>
@@ -39,12 +40,16 @@ Bvh binary(const std::vector<Triangle>& triangles) {
     return build_bvh(triangles, config);
 }
 
+std::array<float, 6> corners(const Aabb& box) {
+    return {box.lo.x, box.lo.y, box.lo.z, box.hi.x, box.hi.y, box.hi.z};
+}
+
 /// The binary tree's leaves as (first triangle, count), and its boxes.
 void binary_leaves(const Bvh& bvh, std::set<std::pair<uint32_t, uint32_t>>& leaves,
-                   std::multiset<std::pair<float, float>>& boxes) {
+                   std::multiset<std::array<float, 6>>& boxes) {
     for (const BvhNode& node : bvh.nodes) {
         if (node.is_leaf()) leaves.insert({node.first_triangle, node.triangle_count});
-        boxes.insert({node.bounds.lo.x + 2 * node.bounds.hi.y, node.bounds.hi.z});
+        boxes.insert(corners(node.bounds));
     }
 }
 
@@ -81,7 +86,7 @@ TEST_CASE("Collapsing keeps every leaf and box of the binary tree, at most `widt
     CHECK(wide.stats.width == width);
 
     std::set<std::pair<uint32_t, uint32_t>> leaves, wide_leaves;
-    std::multiset<std::pair<float, float>> boxes, wide_boxes;
+    std::multiset<std::array<float, 6>> boxes, wide_boxes;
     binary_leaves(bvh, leaves, boxes);
     uint64_t children = 0;
     for (size_t n = 0; n < wide.nodes.size(); ++n) {
@@ -92,7 +97,7 @@ TEST_CASE("Collapsing keeps every leaf and box of the binary tree, at most `widt
         bool all_leaves = true;
         for (uint32_t c = 0; c < node.child_count; ++c) {
             const WideChild& child = node.children[c];
-            wide_boxes.insert({child.bounds.lo.x + 2 * child.bounds.hi.y, child.bounds.hi.z});
+            wide_boxes.insert(corners(child.bounds));
             if (child.is_leaf()) {
                 CHECK(wide_leaves.insert({child.first_triangle, child.triangle_count}).second);
             } else {

@@ -141,6 +141,42 @@ TEST_CASE("BVH node orders move the traffic, never the image or the instructions
         }
 }
 
+namespace {
+
+/// The small Cornell box on the tiny chip through another structure's tracer. The wide BVH's
+/// and the kd-tree's traversal stacks (64 and 40 entries) do not fit the tiny chip's 1 KiB of
+/// local store; two TMs give each of two host threads one.
+render::RenderOptions structure_run(const char* kernel) {
+    render::RenderOptions options;
+    options.scene = small_cornell();
+    options.kernel = std::filesystem::path(TPSIM_KERNEL_DIR) / kernel;
+    options.engine = render::Engine::timing;
+    options.chip = tiny();
+    options.chip.tp.local_store_bytes = 2048;
+    options.chip.chip.num_tms = 2;
+    return options;
+}
+
+/// Renders on one and on two host threads; CHECKs that both give `reference`'s image without a
+/// stack overflow and the same statistics. Returns the first.
+render::RenderResult render_on_one_and_two_host_threads(const render::RenderOptions& options,
+                                                        const render::RenderResult& reference) {
+    std::optional<render::RenderResult> first;
+    for (uint32_t host_threads : {1u, 2u}) {
+        core::set_host_threads(host_threads);
+        auto result = render::render(options);
+        CHECK(same_bits(result.rgb, reference.rgb));
+        CHECK(result.traversal.stack_overflows == 0);
+        if (!first)
+            first = std::move(result);
+        else
+            CHECK(simulated_stats(result) == simulated_stats(*first));
+    }
+    return std::move(*first);
+}
+
+}  // namespace
+
 TEST_CASE("The wide BVHs render the binary BVH's image in both box formats, the same on one "
           "and on two host threads",
           "[render][invariance][wide]") {
@@ -155,31 +191,13 @@ TEST_CASE("The wide BVHs render the binary BVH's image in both box formats, the 
         double float_bytes = 0;
         for (scene::BvhBoxes boxes : scene::kBvhBoxes) {
             INFO(scene::to_string(structure) << " " << scene::to_string(boxes));
-            std::optional<render::RenderResult> first;
-            for (uint32_t host_threads : {1u, 2u}) {
-                core::set_host_threads(host_threads);
-                render::RenderOptions options;
-                options.scene = small_cornell();
-                options.kernel = TPSIM_KERNEL_DIR "/tracer_wide.elf";
-                options.engine = render::Engine::timing;
-                options.chip = tiny();
-                // The wide traversal's stack (64 entries) does not fit the tiny chip's 1 KiB.
-                options.chip.tp.local_store_bytes = 2048;
-                options.chip.chip.num_tms = 2;  // one per host thread
-                options.accel = structure;
-                options.bvh.boxes = boxes;
-                auto result = render::render(options);
-                CHECK(same_bits(result.rgb, reference.rgb));
-                CHECK(result.traversal.stack_overflows == 0);
-                REQUIRE(result.wide_bvh);
-                CHECK(result.wide_bvh->width == scene::wide_bvh_width(structure));
-                if (!first) {
-                    first = std::move(result);
-                    continue;
-                }
-                CHECK(simulated_stats(result) == simulated_stats(*first));
-            }
-            const double bytes = stat(*first, "memory/bvh_nodes_bytes");
+            render::RenderOptions options = structure_run("tracer_wide.elf");
+            options.accel = structure;
+            options.bvh.boxes = boxes;
+            const auto result = render_on_one_and_two_host_threads(options, reference);
+            REQUIRE(result.wide_bvh);
+            CHECK(result.wide_bvh->width == scene::wide_bvh_width(structure));
+            const double bytes = stat(result, "memory/bvh_nodes_bytes");
             if (boxes == scene::BvhBoxes::floats)
                 float_bytes = bytes;
             else
@@ -214,42 +232,20 @@ TEST_CASE("every key a cycle-level render registers is documented in docs/statis
         CHECK((keys.count("chip/icache/misses") == 1) == chip.icache.finite());
     }
     // The wide BVH's keys exist only with one.
-    render::RenderOptions wide;
-    wide.scene = small_cornell();
-    wide.kernel = TPSIM_KERNEL_DIR "/tracer_wide.elf";
-    wide.engine = render::Engine::timing;
-    wide.chip = tiny();
-    wide.chip.tp.local_store_bytes = 2048;
+    const render::RenderOptions wide = structure_run("tracer_wide.elf");
     CHECK(check_documented(render::render(wide)).count("wide_bvh/nodes") == 1);
     // And the kd-tree's.
-    render::RenderOptions kdtree = wide;
-    kdtree.kernel = TPSIM_KERNEL_DIR "/tracer_kdtree.elf";
-    CHECK(check_documented(render::render(kdtree)).count("kdtree/references") == 1);
+    CHECK(check_documented(render::render(structure_run("tracer_kdtree.elf")))
+              .count("kdtree/references") == 1);
 }
 
 TEST_CASE("The kd-tree renders the binary BVH's image, the same on one and on two host threads",
           "[render][invariance][kdtree]") {
     const auto reference = render_cornell(render::Engine::timing, tiny());
-    std::optional<render::RenderResult> first;
-    for (uint32_t host_threads : {1u, 2u}) {
-        core::set_host_threads(host_threads);
-        render::RenderOptions options;
-        options.scene = small_cornell();
-        options.kernel = TPSIM_KERNEL_DIR "/tracer_kdtree.elf";
-        options.engine = render::Engine::timing;
-        options.chip = tiny();
-        options.chip.tp.local_store_bytes = 2048;  // the 40-entry stack needs more than 1 KiB
-        options.chip.chip.num_tms = 2;             // one per host thread
-        auto result = render::render(options);
-        CHECK(same_bits(result.rgb, reference.rgb));
-        CHECK(result.traversal.stack_overflows == 0);
-        REQUIRE(result.kdtree);
-        CHECK(result.kdtree->references >= result.scene.triangles.size());
-        if (!first)
-            first = std::move(result);
-        else
-            CHECK(simulated_stats(result) == simulated_stats(*first));
-    }
+    const auto result =
+        render_on_one_and_two_host_threads(structure_run("tracer_kdtree.elf"), reference);
+    REQUIRE(result.kdtree);
+    CHECK(result.kdtree->references >= result.scene.triangles.size());
 }
 
 namespace {
