@@ -1,7 +1,7 @@
 // How far apart two host cores are (scripts/bench-threads): the time one cache line takes to
 // go from core A to core B and back, as the parallel simulation's lanes pass their stretch
 // counts and turns every few microseconds. On a virtual machine it changes with where the
-// host places the virtual cores (docs/performance.md, "Host threads", session 19).
+// host places the virtual cores (docs/performance.md, "Host threads").
 //   bench_core_link [CORE_A CORE_B]     (default: cores 0 and 1) -> "round trip: N ns"
 #include <atomic>
 #include <chrono>
