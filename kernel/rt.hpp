@@ -84,7 +84,13 @@ constexpr float gamma(int n) {
     return float(n) * 0x1p-24f / (1.0f - float(n) * 0x1p-24f);
 }
 
-/// Whether the ray meets the triangle at address `tri` with 0 < t < t_max, and where. Two-sided.
+/// A triangle's vertices on a sheared ray's permuted axes: what intersect_vertices() tests.
+struct PermutedTriangle {
+    float x0, y0, z0, x1, y1, z1, x2, y2, z2;
+};
+
+/// Whether the ray meets the triangle `tri` with 0 < t < t_max, and where.
+/// Two-sided.
 ///
 /// Inside or outside: the edge functions of Woop, Benthin and Wald's watertight test. The
 /// paper's double-precision fallback for edge coefficients that are exactly zero is left out
@@ -103,16 +109,13 @@ constexpr float gamma(int n) {
 /// whose numerator or denominator could have the wrong sign is rejected, so t > 0 is certain:
 /// a ray leaving a surface from an origin on the right side of its plane never hits it again.
 /// Always inlined into the loops so the ray stays in registers across triangles; callers that
-/// ignore the plane error (any-hit rays) do not compute it.
-[[gnu::always_inline]] inline bool intersect(const ShearedRay& r, int tri, float t_max,
-                                             TriangleHit& hit) {
-    // Vertex coordinates on the permuted axes. One address per axis, so the three vertices'
-    // coordinates on it are constant offsets from it (one flw each).
-    const int x = tri + r.kx, y = tri + r.ky, z = tri + r.kz;
-    const float x0 = loadf(x, kTriangleV0), y0 = loadf(y, kTriangleV0), z0 = loadf(z, kTriangleV0);
-    const float x1 = loadf(x, kTriangleV1), y1 = loadf(y, kTriangleV1), z1 = loadf(z, kTriangleV1);
-    const float x2 = loadf(x, kTriangleV2), y2 = loadf(y, kTriangleV2), z2 = loadf(z, kTriangleV2);
-
+/// ignore the plane error (any-hit rays) do not compute it. intersect() below loads the
+/// vertices; a packet (packet.hpp) loads each triangle once for all its rays.
+[[gnu::always_inline]] inline bool intersect_vertices(const ShearedRay& r,
+                                                      const PermutedTriangle& tri, float t_max,
+                                                      TriangleHit& hit) {
+    const float x0 = tri.x0, y0 = tri.y0, z0 = tri.z0, x1 = tri.x1, y1 = tri.y1, z1 = tri.z1,
+                x2 = tri.x2, y2 = tri.y2, z2 = tri.z2;
     // Vertices relative to the origin, sheared so the ray runs along +z through (0, 0).
     const float a_z = z0 - r.oz, b_z = z1 - r.oz, c_z = z2 - r.oz;
     const float a_x = x0 - r.ox - r.sx * a_z;
@@ -165,6 +168,18 @@ constexpr float gamma(int n) {
     // plus the rounding of the scaling, the reciprocal and the product.
     hit.plane_error = num_error + num * inverse_den * den_error + gamma(3) * num;
     return true;
+}
+
+/// intersect_vertices() for the triangle at address `tri`.
+[[gnu::always_inline]] inline bool intersect(const ShearedRay& r, int tri, float t_max,
+                                             TriangleHit& hit) {
+    // Vertex coordinates on the permuted axes. One address per axis, so the three vertices'
+    // coordinates on it are constant offsets from it (one flw each).
+    const int x = tri + r.kx, y = tri + r.ky, z = tri + r.kz;
+    const PermutedTriangle v{loadf(x, kTriangleV0), loadf(y, kTriangleV0), loadf(z, kTriangleV0),
+                             loadf(x, kTriangleV1), loadf(y, kTriangleV1), loadf(z, kTriangleV1),
+                             loadf(x, kTriangleV2), loadf(y, kTriangleV2), loadf(z, kTriangleV2)};
+    return intersect_vertices(r, v, t_max, hit);
 }
 
 /// Counts of one ray's traversal.
@@ -562,9 +577,42 @@ Hit trace_closest_to(const Accel& accel, const SurfacePoint& s, Vec3 target, Ray
     return trace_segment<false>(accel, s, target, stats);
 }
 
+/// A closest hit ready for Lambert shading: its surface point, the normal facing the ray and the
+/// material's albedo.
+struct LitPoint {
+    SurfacePoint surface;
+    Vec3 n;
+    Vec3 albedo;
+};
+
+[[gnu::always_inline]] inline LitPoint lit_point(const Shading& s, const Hit& hit, Vec3 origin,
+                                                 Vec3 dir) {
+    const int tri = s.triangles + hit.triangle * kTriangleWords;
+    const SurfacePoint surface = surface_point(tri, hit, origin, dir);
+    const Vec3 n = dot(surface.n, dir) > 0.0f ? surface.n * -1.0f : surface.n;  // two-sided
+    const Vec3 albedo =
+        load_vec3(s.materials + loadi(tri, kTriangleMaterial) * kMaterialWords, kMaterialDiffuse);
+    return {surface, n, albedo};
+}
+
+/// Whether the point light at `position` faces the point, and its weight there: the cosine,
+/// over d^2 when the scene asks for falloff.
+[[gnu::always_inline]] inline bool light_weight(const Shading& s, const LitPoint& lit,
+                                                Vec3 position, float& weight) {
+    const Vec3 to_light = position - lit.surface.p;
+    const float n_dot_l = dot(lit.n, to_light);
+    if (n_dot_l <= 0.0f) return false;
+    const float distance2 = dot(to_light, to_light);
+    weight = n_dot_l / trax_sqrt(distance2);  // cosine
+    if (s.flags & kFeatureLightFalloff) weight = weight / distance2;
+    return true;
+}
+
 /// Lambert shading of the camera ray (origin, dir): ambient plus every point light facing the
 /// surface, with hard shadows (any-hit rays from the offset hit point) and 1/d^2 falloff when
-/// the scene asks for them. shade() below is this with the default policy.
+/// the scene asks for them. shade() below is this with the default policy. Its statements are
+/// lit_point() and light_weight() written out: calling them moves the tracer's code (clang keeps
+/// the struct in memory), and with it the reference statistics.
 template <RenderPolicy kPolicy, class Accel>
 [[gnu::always_inline]] inline Vec3 shade_with(const Shading& s, const Accel& accel, Vec3 origin,
                                               Vec3 dir, ThreadTotals& totals) {
@@ -663,31 +711,27 @@ struct CameraRays {
     }
 };
 
-/// The whole render kernel: pixels handed out with atomicinc(0) in the policy's order; each gets
-/// samples_per_pixel camera rays (CameraRays::direction), shaded and averaged into the framebuffer
-/// as linear RGB; the thread's statistics record is written at the end. render_image() below is
-/// this with the default policy.
-template <RenderPolicy kPolicy, class Accel>
-[[gnu::always_inline]] inline void render_image_with(const Accel& accel) {
-    const Shading s = Shading::from_scene();
+/// The pixel loop of the image kernels: work items handed out with atomicinc(0) in `kOrder`;
+/// each pixel gets samples_per_pixel camera rays (CameraRays::direction), each shaded by
+/// shade_sample(origin, dir, pixel, sample, totals) and averaged into the framebuffer as linear
+/// RGB; the thread's statistics record is written at the end.
+template <PixelOrder kOrder, class ShadeSample>
+[[gnu::always_inline]] inline void render_pixels(const ShadeSample& shade_sample) {
     const int width = trax_image_width(), height = trax_image_height();
     const int samples = trax_samples_per_pixel();
     const CameraRays camera = CameraRays::from_scene();
     const int framebuffer = trax_framebuffer();
     ThreadTotals totals;
 
-    const int items = work_items(width, height, kPolicy.order);
+    const int items = work_items(width, height, kOrder);
     for (int item = atomicinc(0); item < items; item = atomicinc(0)) {
-        const int pixel = pixel_of(item, width, height, kPolicy.order);
-        if constexpr (kPolicy.order != PixelOrder::scanlines)
+        const int pixel = pixel_of(item, width, height, kOrder);
+        if constexpr (kOrder != PixelOrder::scanlines)
             if (pixel < 0) continue;
         Vec3 color{0.0f, 0.0f, 0.0f};
         for (int sample = 0; sample < samples; ++sample) {
             const Vec3 dir = camera.direction(pixel, sample, samples);
-            if constexpr (kPolicy == RenderPolicy{})
-                color = color + shade(s, accel, camera.eye, dir, totals);
-            else
-                color = color + shade_variant<kPolicy>(s, accel, camera.eye, dir, totals);
+            color = color + shade_sample(camera.eye, dir, pixel, sample, totals);
         }
         color = color * (1.0f / static_cast<float>(samples));
         const int out = framebuffer + pixel * kPixelWords;
@@ -696,6 +740,19 @@ template <RenderPolicy kPolicy, class Accel>
         storef(color.z, out, 2);
     }
     totals.store();
+}
+
+/// The whole render kernel: render_pixels() with shade_with() in the policy's order.
+/// render_image() below is this with the default policy.
+template <RenderPolicy kPolicy, class Accel>
+[[gnu::always_inline]] inline void render_image_with(const Accel& accel) {
+    const Shading s = Shading::from_scene();
+    render_pixels<kPolicy.order>([&](Vec3 origin, Vec3 dir, int, int, ThreadTotals& totals) {
+        if constexpr (kPolicy == RenderPolicy{})
+            return shade(s, accel, origin, dir, totals);
+        else
+            return shade_variant<kPolicy>(s, accel, origin, dir, totals);
+    });
 }
 
 template <class Accel> void render_image(const Accel& accel) {

@@ -22,27 +22,28 @@
 
 namespace tpsim::test {
 
-/// One structure as a test builds it: its kind and, for a wide BVH, its box format.
+/// One structure as a test builds it: its kind, for a wide BVH its box format, and for the
+/// binary BVH whether packets of rays traverse it (ray_query_packet).
 struct AccelVariant {
     scene::AccelStructure structure;
     scene::BvhBoxes boxes = scene::BvhBoxes::floats;
+    bool packets = false;
 };
 
 inline std::string to_string(AccelVariant v) {
     std::string name(scene::to_string(v.structure));
     if (scene::wide_bvh_width(v.structure) != 0) name += std::string(" ") + to_string(v.boxes);
+    if (v.packets) name += " packets";
     return name;
 }
 
-/// Every structure tpsim builds, every wide BVH in both box formats.
+/// Every structure tpsim builds, every wide BVH in both box formats, the binary BVH also in
+/// packets.
 inline constexpr AccelVariant kAccelVariants[] = {
-    {scene::AccelStructure::bvh2},
-    {scene::AccelStructure::bvh4},
-    {scene::AccelStructure::bvh4, scene::BvhBoxes::quantized},
-    {scene::AccelStructure::bvh8},
-    {scene::AccelStructure::bvh8, scene::BvhBoxes::quantized},
-    {scene::AccelStructure::grid},
-    {scene::AccelStructure::kdtree},
+    {scene::AccelStructure::bvh2}, {scene::AccelStructure::bvh2, scene::BvhBoxes::floats, true},
+    {scene::AccelStructure::bvh4}, {scene::AccelStructure::bvh4, scene::BvhBoxes::quantized},
+    {scene::AccelStructure::bvh8}, {scene::AccelStructure::bvh8, scene::BvhBoxes::quantized},
+    {scene::AccelStructure::grid}, {scene::AccelStructure::kdtree},
 };
 
 /// A structure built for a mesh as render() builds it (the BVH with the kernels' depth limit).
@@ -92,10 +93,11 @@ struct BuiltAccel {
                grid->stats.resolution[2] - 2;
     }
     const char* kernel() const {
-        return grid     ? "ray_query_grid.elf"
-               : wide   ? "ray_query_wide.elf"
-               : kdtree ? "ray_query_kdtree.elf"
-                        : "ray_query.elf";
+        return grid              ? "ray_query_grid.elf"
+               : wide            ? "ray_query_wide.elf"
+               : kdtree          ? "ray_query_kdtree.elf"
+               : variant.packets ? "ray_query_packet.elf"
+                                 : "ray_query.elf";
     }
 };
 

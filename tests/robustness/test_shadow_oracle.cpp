@@ -501,9 +501,10 @@ TEST_CASE("shadow oracle: no holes, false shadows or leaks on the corpus, agains
     // verdict. A tie on a shared edge may pick the other triangle, whose normal offsets the
     // shadow ray's origin otherwise: so shadow verdicts may differ, but only where the oracle
     // calls them ambiguous (an occluder within a few ulps of the start).
-    // Each width and each box format once (test_robustness runs every combination).
+    // Each width and each box format once, and packets (test_robustness runs every combination).
     using scene::AccelStructure;
     const test::AccelVariant variants[] = {{AccelStructure::bvh2},
+                                           {AccelStructure::bvh2, scene::BvhBoxes::floats, true},
                                            {AccelStructure::bvh4, scene::BvhBoxes::quantized},
                                            {AccelStructure::bvh8},
                                            {AccelStructure::grid},

@@ -248,6 +248,29 @@ TEST_CASE("The kd-tree renders the binary BVH's image, the same on one and on tw
     CHECK(result.kdtree->references >= result.scene.triangles.size());
 }
 
+TEST_CASE("Packets render the single-ray kernels' images, the same on one and on two host "
+          "threads: tracer_packet the tracer's, ao_packet ao's",
+          "[render][invariance][packets]") {
+    // 31 x 29: the last column and row of 2 x 2 blocks hold one pixel of each packet's pairs.
+    const auto odd_size = [](const char* kernel) {
+        render::RenderOptions options = structure_run(kernel);
+        options.image_width = 31;
+        options.image_height = 29;
+        return options;
+    };
+    for (const auto& [single, packet] :
+         {std::pair{"tracer.elf", "tracer_packet.elf"}, std::pair{"ao.elf", "ao_packet.elf"}}) {
+        INFO(single << " against " << packet);
+        const auto reference = render::render(odd_size(single));
+        const auto result = render_on_one_and_two_host_threads(odd_size(packet), reference);
+        // The same rays: every camera ray, and every shadow or occlusion ray.
+        CHECK(result.traversal.primary_rays == 31 * 29);
+        CHECK(result.traversal.primary_rays == reference.traversal.primary_rays);
+        CHECK(result.traversal.shadow_rays == reference.traversal.shadow_rays);
+        CHECK(result.traversal.shadow_rays > result.traversal.primary_rays / 2);
+    }
+}
+
 namespace {
 
 /// The reference the machine source's run-ahead must match: every instruction executed at
