@@ -32,6 +32,8 @@ constexpr const char* kUsesGridSymbol = "trax_uses_grid";
 constexpr const char* kUsesWideBvhSymbol = "trax_uses_wide_bvh";
 /// The same for a kernel that traverses the kd-tree (TRAX_USES_KDTREE).
 constexpr const char* kUsesKdTreeSymbol = "trax_uses_kdtree";
+/// The same for a kernel that traverses the octree (TRAX_USES_OCTREE).
+constexpr const char* kUsesOctreeSymbol = "trax_uses_octree";
 /// Name of the marker symbol trax.hpp's emitter and random-number functions leave in a kernel's
 /// ELF: the host adds the SceneExtras sections only for such kernels, so the memory image (and
 /// every statistic) of a kernel that reads neither stays as it was before they existed.
@@ -131,6 +133,7 @@ enum AccelKind : int32_t {
     kAccelGrid = 1,
     kAccelWideBvh = 2,
     kAccelKdTree = 3,
+    kAccelOctree = 4,
 };
 
 /// Entries in the kd-tree traversal stack (kernel/kdtree.hpp): one per level, the host builds
@@ -141,6 +144,20 @@ constexpr int32_t kKdStackEntries = 40;
 /// first of its references and kKdLeaf | count << 2.
 constexpr int32_t kKdNodeWords = 2;
 constexpr uint32_t kKdLeaf = 3;
+
+/// Entries in the octree traversal stack (kernel/octree.hpp): a cell pushes at most the three
+/// octants after the first, the host builds no deeper tree than a third of this
+/// (scene::kOctreeMaxDepth).
+constexpr int32_t kOctreeStackEntries = 48;
+/// Octree nodes are four words, in groups of eight siblings (octant c at + c: bit 0 set above
+/// the centre on x, bit 1 on y, bit 2 on z; 128 bytes, two lines), the root alone in group 0.
+/// Word kOctreeShape is first_child << 8 | occupied (bit c: octant c holds triangles; the
+/// others are never read) for an interior node, -1 for a leaf. An interior node's words 0..2
+/// hold the centre it cuts its cell at; a leaf's words kOctreeFirst and kOctreeCount its first
+/// reference and how many.
+constexpr int32_t kOctreeNodeWords = 4;
+constexpr int32_t kOctreeShape = 3, kOctreeFirst = 0, kOctreeCount = 1;
+constexpr int32_t kOctreeMaxFirstChild = (1 << 23) - 1;
 
 /// A wide-BVH child reference, the same in both box formats: 0 is no child (a node's children
 /// come first, its empty slots last); > 0 is the word address of an interior child's node; < 0
@@ -180,6 +197,10 @@ constexpr int32_t wide_quantized_boxes_byte(int32_t width) {
 /// (kKdNodeWords each, count in words, the root first, depth-first), `refs` the leaves'
 /// triangles (image triangle indices, in scene order; a triangle is listed in every leaf its
 /// bounding box reaches).
+///
+/// Octree (kAccelOctree): the bounds are the root cell; `nodes` holds the nodes
+/// (kOctreeNodeWords each, count in words), `refs` the leaves' triangles (image triangle
+/// indices, in scene order; a triangle is listed in every leaf its bounding box reaches).
 ///
 /// Wide BVH (kAccelWideBvh): `width` (4 or 8) children per node, boxes quantized or not; the
 /// bounds are the root's box; `nodes` holds the nodes (count in words, the root first, each

@@ -145,6 +145,13 @@ TRAX_CSR_FUNCTION(trax_tm_size, 0xCC4)
         ".globl trax_uses_kdtree\n.type trax_uses_kdtree, @function\n"                             \
         "trax_uses_kdtree:\n  ret\n.size trax_uses_kdtree, . - trax_uses_kdtree\n.popsection")
 
+/// Write `TRAX_USES_OCTREE;` at file scope in a kernel that traverses the octree (kernel/
+/// octree.hpp): tpsim then builds the octree (trax::layout::kUsesOctreeSymbol).
+#define TRAX_USES_OCTREE                                                                           \
+    asm(".pushsection .text.trax_uses_octree, \"ax\", @progbits\n"                                 \
+        ".globl trax_uses_octree\n.type trax_uses_octree, @function\n"                             \
+        "trax_uses_octree:\n  ret\n.size trax_uses_octree, . - trax_uses_octree\n.popsection")
+
 namespace trax::detail {
 /// Leaves the marker trax::layout::kUsesExtrasSymbol in the ELF (once per object file: .ifndef;
 /// weak, so objects may share it; kept by the link script). Called by every function that reads
@@ -180,6 +187,7 @@ TRAX_INLINE void set_rand_state(uint32_t state) {
 #define TRAX_USES_GRID static_assert(true)
 #define TRAX_USES_WIDE_BVH static_assert(true)
 #define TRAX_USES_KDTREE static_assert(true)
+#define TRAX_USES_OCTREE static_assert(true)
 
 namespace trax::native {
 

@@ -221,8 +221,8 @@ std::vector<SetupDifference> setup_differences(const std::vector<StatsFile>& run
     };
     for (const char* field :
          {"scene", "kernel", "engine", "accel", "grid_resolution", "grid_density",
-          "kdtree_max_depth", "kdtree_max_references", "bvh_builder", "max_leaf", "bvh_order",
-          "bvh_align_pairs", "bvh_boxes"}) {
+          "kdtree_max_depth", "kdtree_max_references", "octree_max_depth", "bvh_builder",
+          "max_leaf", "bvh_order", "bvh_align_pairs", "bvh_boxes"}) {
         std::vector<std::string> values;
         for (const StatsFile& run : runs)
             values.push_back(run_field(run, field));

@@ -38,6 +38,7 @@ struct RenderCommandOptions {
     double grid_density = scene::GridConfig{}.density;
     uint32_t kdtree_max_depth = 0;
     double kdtree_max_references = scene::KdTreeConfig{}.max_references_per_triangle;
+    uint32_t octree_max_depth = 0;
     std::vector<std::string> params;
     std::string config;
     std::vector<std::string> overrides;
@@ -91,6 +92,7 @@ int run_render(RenderCommandOptions& o) {
     options.grid.density = o.grid_density;
     options.kdtree.max_depth = o.kdtree_max_depth;
     options.kdtree.max_references_per_triangle = o.kdtree_max_references;
+    options.octree.max_depth = o.octree_max_depth;
     options.params = o.params;
     options.engine = o.native             ? render::Engine::native
                      : o.timing != "none" ? render::Engine::timing
@@ -232,9 +234,9 @@ Command add_render_command(CLI::App& app) {
     command
         ->add_option("--accel", o->accel,
                      "Acceleration structure: bvh2 (binary BVH, kernel tracer), bvh4 or bvh8 "
-                     "(wide BVHs, kernel tracer_wide), grid (uniform grid, kernel tracer_grid) "
-                     "or kdtree (kernel tracer_kdtree); with --kernel, one the kernel traverses "
-                     "(docs/accel.md) [default: the kernel's]")
+                     "(wide BVHs, kernel tracer_wide), grid (uniform grid, kernel tracer_grid), "
+                     "kdtree (kernel tracer_kdtree) or octree (kernel tracer_octree); with "
+                     "--kernel, one the kernel traverses (docs/accel.md) [default: the kernel's]")
         ->check(CLI::IsMember(scene::accel_names()));
     command
         ->add_option("--grid-resolution", o->grid_resolution,
@@ -257,6 +259,11 @@ Command add_render_command(CLI::App& app) {
                      "kd-tree: most leaf references per triangle, on average, before the build "
                      "is refused")
         ->check(CLI::Range(1.0, 1e6))
+        ->capture_default_str();
+    command
+        ->add_option("--octree-max-depth", o->octree_max_depth,
+                     fmt::format("Octree: deepest leaf; 0: {}", scene::kOctreeMaxDepth))
+        ->check(whole_number_in(0, scene::kOctreeMaxDepth))
         ->capture_default_str();
     command
         ->add_option("-p,--param", o->params,

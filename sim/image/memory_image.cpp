@@ -284,6 +284,7 @@ MemoryImage build_memory_image(const scene::Scene& scene, Accel accel, uint32_t 
     const scene::WideBvh* wide = accel.wide_bvh;
     const scene::Grid* grid = accel.grid;
     const scene::KdTree* kdtree = accel.kdtree;
+    const scene::Octree* octree = accel.octree;
     const std::vector<uint32_t>* triangle_order = bvh    ? &bvh->triangle_order
                                                   : wide ? &wide->triangle_order
                                                          : nullptr;
@@ -346,7 +347,20 @@ MemoryImage build_memory_image(const scene::Scene& scene, Accel accel, uint32_t 
         put(accel_record.bounds_min, kdtree->bounds.lo);
         put(accel_record.bounds_max, kdtree->bounds.hi);
     }
-    const bool has_record = grid != nullptr || wide != nullptr || kdtree != nullptr;
+    if (octree != nullptr) {
+        accel_record.kind = layout::kAccelOctree;
+        accel_record.nodes.count =
+            checked_count(octree->nodes.size() * layout::kOctreeNodeWords, "octree node words");
+        accel_record.refs.count = checked_count(octree->references.size(), "octree references");
+        if (octree->nodes.size() > size_t(layout::kOctreeMaxFirstChild))
+            throw Error(fmt::format("the octree has {} nodes, more than the {} its nodes can "
+                                    "address; lower --octree-max-depth",
+                                    octree->nodes.size(), layout::kOctreeMaxFirstChild));
+        put(accel_record.bounds_min, octree->bounds.lo);
+        put(accel_record.bounds_max, octree->bounds.hi);
+    }
+    const bool has_record =
+        grid != nullptr || wide != nullptr || kdtree != nullptr || octree != nullptr;
     const uint64_t pixels = uint64_t(scene.width) * scene.height;
     if (pixels > uint64_t(std::numeric_limits<int32_t>::max() / 16))
         throw Error(fmt::format("image {}x{} is too large for the 32-bit memory image", scene.width,
@@ -447,6 +461,23 @@ MemoryImage build_memory_image(const scene::Scene& scene, Accel accel, uint32_t 
         std::memcpy(image.words.data() + accel_record.refs.addr, kdtree->references.data(),
                     kdtree->references.size() * 4);
     }
+    if (octree != nullptr) {
+        write(image.words, h.accel, accel_record);
+        uint32_t* out = image.words.data() + accel_record.nodes.addr;
+        for (const scene::OctreeNode& node : octree->nodes) {
+            if (node.leaf) {
+                out[layout::kOctreeFirst] = node.first;
+                out[layout::kOctreeCount] = node.count;
+                out[layout::kOctreeShape] = ~0u;
+            } else {
+                std::memcpy(&out[0], node.centre.data(), 12);
+                out[layout::kOctreeShape] = node.first_child << 8 | node.occupied;
+            }
+            out += layout::kOctreeNodeWords;
+        }
+        std::memcpy(image.words.data() + accel_record.refs.addr, octree->references.data(),
+                    octree->references.size() * 4);
+    }
     if (wide != nullptr) {
         write(image.words, h.accel, accel_record);
         const std::vector<uint32_t> nodes =
@@ -494,6 +525,13 @@ MemoryImage build_memory_image(const scene::Scene& scene, Accel accel, uint32_t 
                                   uint64_t(accel_record.nodes.count) * 4,
                                   uint64_t(accel_record.nodes.addr) * 4});
         image.sections.push_back(section("kdtree_refs", accel_record.refs, 1));
+    }
+    if (octree != nullptr) {
+        image.sections.push_back({"octree", 1, sizeof(accel_record), uint64_t(h.accel) * 4});
+        image.sections.push_back({"octree_nodes", uint32_t(octree->nodes.size()),
+                                  uint64_t(accel_record.nodes.count) * 4,
+                                  uint64_t(accel_record.nodes.addr) * 4});
+        image.sections.push_back(section("octree_refs", accel_record.refs, 1));
     }
     image.sections.push_back(section("framebuffer", h.framebuffer, layout::kPixelWords));
     image.sections.push_back(section("thread_stats", h.thread_stats, layout::kThreadStatsWords));

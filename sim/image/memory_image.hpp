@@ -11,6 +11,7 @@
 #include "sim/scene/bvh.hpp"
 #include "sim/scene/grid.hpp"
 #include "sim/scene/kdtree.hpp"
+#include "sim/scene/octree.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/scene/wide_bvh.hpp"
 
@@ -47,6 +48,7 @@ struct Accel {
     scene::BvhBoxes bvh_boxes = scene::BvhBoxes::floats;         ///< scene::BvhConfig::boxes
     const scene::Grid* grid = nullptr;
     const scene::KdTree* kdtree = nullptr;
+    const scene::Octree* octree = nullptr;
     Accel(std::nullptr_t = nullptr) {}
     Accel(const scene::Bvh* b, scene::BvhOrder order = scene::BvhOrder::breadth_first,
           bool align_pairs = false)
@@ -55,6 +57,7 @@ struct Accel {
         : wide_bvh(b), bvh_order(order), bvh_boxes(boxes) {}
     Accel(const scene::Grid* g) : grid(g) {}
     Accel(const scene::KdTree* k) : kdtree(k) {}
+    Accel(const scene::Octree* o) : octree(o) {}
 };
 
 /// The BVH section: the builder's nodes as layout::BvhNode wants them, the root at index 0 and
@@ -76,7 +79,8 @@ std::vector<uint32_t> compile_wide_bvh(const scene::WideBvh& bvh, scene::BvhOrde
 /// "grid_cells", "grid_refs"), triangles in scene order. With a wide BVH, the AccelRecord
 /// ("bvh_root") and the wide nodes ("bvh_nodes", the binary BVH's region name, so that traffic
 /// compares across widths), triangles in leaf order. With a kd-tree, the AccelRecord and its
-/// nodes and references ("kdtree", "kdtree_nodes", "kdtree_refs"), triangles in scene order.
+/// nodes and references ("kdtree", "kdtree_nodes", "kdtree_refs"), triangles in scene order; the
+/// same for an octree ("octree", "octree_nodes", "octree_refs").
 /// One zeroed ThreadStats record per thread (`threads` of them); `rays` (for the ray_query
 /// kernel) and room for as many RayResults. With `extras_seed`, also the SceneExtras record
 /// (that run seed, every material's emission, the emissive triangles): only for kernels that

@@ -200,6 +200,7 @@ RenderResult render(const RenderOptions& options) {
     std::optional<scene::WideBvh> wide_bvh;
     std::optional<scene::Grid> grid;
     std::optional<scene::KdTree> kdtree;
+    std::optional<scene::Octree> octree;
     if (result.accel == scene::AccelStructure::bvh2 || width != 0) {
         start = std::chrono::steady_clock::now();
         scene::BvhConfig config = options.bvh;
@@ -241,6 +242,11 @@ RenderResult render(const RenderOptions& options) {
             return scene::build_kdtree(result.scene.triangles, options.kdtree);
         });
         result.kdtree = kdtree->stats;
+    } else if (result.accel == scene::AccelStructure::octree) {
+        octree = timed_build(result.octree_seconds, [&] {
+            return scene::build_octree(result.scene.triangles, options.octree);
+        });
+        result.octree = octree->stats;
     }
     result.threads = options.chip.chip.num_tms * options.chip.chip.tps_per_tm;
     const image::Accel accel = bvh ? image::Accel(&*bvh, options.bvh.order, options.bvh.align_pairs)
@@ -248,6 +254,7 @@ RenderResult render(const RenderOptions& options) {
                                    ? image::Accel(&*wide_bvh, options.bvh.order, options.bvh.boxes)
                                : grid   ? image::Accel(&*grid)
                                : kdtree ? image::Accel(&*kdtree)
+                               : octree ? image::Accel(&*octree)
                                         : nullptr;
     result.image = image::build_memory_image(result.scene, accel, result.threads, {},
                                              kernel.uses_extras() ? std::optional(options.seed)

@@ -96,6 +96,8 @@ struct RenderOptions {
     scene::GridConfig grid;
     /// The kd-tree to build when the kernel traverses one (TRAX_USES_KDTREE).
     scene::KdTreeConfig kdtree;
+    /// The octree to build when the kernel traverses one (TRAX_USES_OCTREE).
+    scene::OctreeConfig octree;
     /// The structure the user asked for (render --accel): render() refuses a kernel that
     /// traverses another. Unset: whichever the kernel traverses (bvh4 for a wide-BVH kernel).
     std::optional<scene::AccelStructure> accel;
@@ -143,6 +145,7 @@ struct RenderResult {
     std::optional<scene::WideBvhStats> wide_bvh;  ///< when a wide BVH was built
     std::optional<scene::GridStats> grid;         ///< when a grid was built
     std::optional<scene::KdTreeStats> kdtree;     ///< when a kd-tree was built
+    std::optional<scene::OctreeStats> octree;     ///< when an octree was built
     image::MemoryImage image;                     ///< the memory image after the run
     image::TraversalTotals traversal;             ///< the kernel's per-thread statistics, summed
     std::vector<float> rgb;                       ///< framebuffer, linear RGB, row 0 at the top
@@ -153,7 +156,8 @@ struct RenderResult {
     std::shared_ptr<const TimingRun> timing;  ///< Engine::timing: the chip and its counters
     std::shared_ptr<const Profile> profile;   ///< RenderOptions::profile: by function and line
     /// Host wall clock: loading the scene, building the BVH or the grid, running the kernel.
-    double load_seconds = 0, bvh_seconds = 0, grid_seconds = 0, kdtree_seconds = 0, run_seconds = 0;
+    double load_seconds = 0, bvh_seconds = 0, grid_seconds = 0, kdtree_seconds = 0,
+           octree_seconds = 0, run_seconds = 0;
     /// The host threads the kernel run used: at most `host_threads`, for this share of its
     /// instructions (the rest on one; TimingRun).
     uint32_t host_threads = 1;

@@ -287,6 +287,31 @@ void register_stats(const RenderResult& r, stats::Registry& reg) {
         number(
             "host/kdtree_seconds", [&r] { return r.kdtree_seconds; }, "kd-tree build time", "s");
     }
+    if (r.octree) {
+        const scene::OctreeStats& o = *r.octree;
+        number(
+            "octree/nodes", [&o] { return o.nodes; },
+            "octree node slots (empty octants' and the root group's included)");
+        number(
+            "octree/interior", [&o] { return o.interior; }, "octree cells cut into eight");
+        number(
+            "octree/leaves", [&o] { return o.leaves; }, "octree leaves (cells with triangles)");
+        number(
+            "octree/max_depth", [&o] { return o.max_depth; },
+            "edges from the root to the deepest leaf");
+        number(
+            "octree/references", [&o] { return o.references; },
+            "leaf entries (a triangle in k leaves counts k)");
+        number(
+            "octree/references_per_triangle",
+            [&o, &r] { return double(o.references) / double(r.scene.triangles.size()); },
+            "leaves a triangle is listed in, on average");
+        number(
+            "octree/max_leaf_triangles", [&o] { return o.max_leaf_triangles; },
+            "most triangles listed in one leaf");
+        number(
+            "host/octree_seconds", [&r] { return r.octree_seconds; }, "octree build time", "s");
+    }
 
     const image::TraversalTotals& t = r.traversal;
     const auto per_ray = [&t](uint64_t count) {
@@ -482,6 +507,15 @@ void print_summary(const RenderOptions& options, const RenderResult& r,
                    double(k.references) / double(r.scene.triangles.size()), k.max_leaf_triangles,
                    r.kdtree_seconds);
     }
+    if (r.octree) {
+        const scene::OctreeStats& o = *r.octree;
+        fmt::print(out,
+                   "octree   {} cells cut, {} leaves, depth {} (limit {}), {} references ({:.2f} "
+                   "per triangle), at most {} in a leaf, built in {:.3f} s\n",
+                   o.interior, o.leaves, o.max_depth, o.depth_limit, o.references,
+                   double(o.references) / double(r.scene.triangles.size()), o.max_leaf_triangles,
+                   r.octree_seconds);
+    }
     if (r.traversal.rays() > 0) {
         const double rays = double(r.traversal.rays());
         fmt::print(out, "rays     {} ({} primary, {} shadow): {:.1f} {}, {:.1f} triangles per ray",
@@ -572,6 +606,7 @@ nlohmann::ordered_json stats_document(const RenderOptions& options, const Render
         run["kdtree_max_depth"] = options.kdtree.max_depth;
         run["kdtree_max_references"] = options.kdtree.max_references_per_triangle;
     }
+    if (r.octree) run["octree_max_depth"] = options.octree.max_depth;
     run["bvh_builder"] = scene::to_string(options.bvh.builder);
     run["max_leaf"] = options.bvh.max_leaf_size;
     run["bvh_order"] = scene::to_string(options.bvh.order);

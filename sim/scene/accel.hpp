@@ -1,5 +1,6 @@
 // The acceleration structures tpsim builds for a kernel: which one follows from the marker the
-// kernel's ELF defines (TRAX_USES_BVH, TRAX_USES_WIDE_BVH, TRAX_USES_GRID, TRAX_USES_KDTREE);
+// kernel's ELF defines (TRAX_USES_BVH, TRAX_USES_WIDE_BVH, TRAX_USES_GRID, TRAX_USES_KDTREE,
+// TRAX_USES_OCTREE);
 // `render --accel` and the sweep key `accel` name one (for a marker that several share, the one to
 // build) and pick its default kernel.
 #pragma once
@@ -20,6 +21,7 @@ enum class AccelStructure {
     bvh8,    ///< ... to 8 children per node
     grid,    ///< the uniform grid (sim/scene/grid.hpp)
     kdtree,  ///< the kd-tree (sim/scene/kdtree.hpp)
+    octree,  ///< the octree (sim/scene/octree.hpp)
 };
 
 struct AccelInfo {
@@ -42,6 +44,8 @@ constexpr std::array kAccelStructures = {
               "the uniform grid"},
     AccelInfo{AccelStructure::kdtree, "kdtree", "tracer_kdtree", trax::layout::kUsesKdTreeSymbol,
               "the kd-tree"},
+    AccelInfo{AccelStructure::octree, "octree", "tracer_octree", trax::layout::kUsesOctreeSymbol,
+              "the octree"},
 };
 
 constexpr AccelInfo accel_info(AccelStructure structure) {

@@ -20,6 +20,7 @@
 #include "sim/scene/grid.hpp"
 #include "sim/scene/kdtree.hpp"
 #include "sim/scene/load_scene.hpp"
+#include "sim/scene/octree.hpp"
 #include "sim/scene/wide_bvh.hpp"
 
 namespace {
@@ -97,24 +98,29 @@ int main(int argc, char** argv) {
                                double(words.size() * 4) / (1 << 20), "-");
                 }
             }
-            const double cpu_start = cpu_seconds();
-            const auto start = std::chrono::steady_clock::now();
-            const Grid grid = build_grid(scene.triangles);
-            const double wall = seconds_since(start), cpu = cpu_seconds() - cpu_start;
-            const GridStats& g = grid.stats;
-            fmt::print(
-                "{:<14} {:<34} {:>9.1f} {:>9.1f} {:>10.1f} M {:>10.2f}\n", scene.name,
-                fmt::format("grid {}x{}x{}", g.resolution[0], g.resolution[1], g.resolution[2]),
-                wall * 1e3, cpu * 1e3, double(g.bytes()) / (1 << 20),
-                double(grid.references.size()) / double(scene.triangles.size()));
-            const double kd_cpu_start = cpu_seconds();
-            const auto kd_start = std::chrono::steady_clock::now();
-            const KdTree kdtree = build_kdtree(scene.triangles);
-            const KdTreeStats& k = kdtree.stats;
-            fmt::print("{:<14} {:<34} {:>9.1f} {:>9.1f} {:>10.1f} M {:>10.2f}\n", scene.name,
-                       fmt::format("kdtree depth {}", k.max_depth), seconds_since(kd_start) * 1e3,
-                       (cpu_seconds() - kd_cpu_start) * 1e3, double(k.bytes()) / (1 << 20),
-                       double(k.references) / double(scene.triangles.size()));
+            // The structures that cut space into cells: build time, size, references per
+            // triangle.
+            const auto cells_row = [&](auto build, auto label) {
+                const double cpu_start = cpu_seconds();
+                const auto start = std::chrono::steady_clock::now();
+                const auto built = build();
+                const double wall = seconds_since(start), cpu = cpu_seconds() - cpu_start;
+                fmt::print("{:<14} {:<34} {:>9.1f} {:>9.1f} {:>10.1f} M {:>10.2f}\n", scene.name,
+                           label(built.stats), wall * 1e3, cpu * 1e3,
+                           double(built.stats.bytes()) / (1 << 20),
+                           double(built.references.size()) / double(scene.triangles.size()));
+            };
+            cells_row([&] { return build_grid(scene.triangles); },
+                      [](const GridStats& g) {
+                          return fmt::format("grid {}x{}x{}", g.resolution[0], g.resolution[1],
+                                             g.resolution[2]);
+                      });
+            cells_row(
+                [&] { return build_kdtree(scene.triangles); },
+                [](const KdTreeStats& k) { return fmt::format("kdtree depth {}", k.max_depth); });
+            cells_row(
+                [&] { return build_octree(scene.triangles); },
+                [](const OctreeStats& o) { return fmt::format("octree depth {}", o.max_depth); });
         }
     } catch (const std::exception& e) {
         fmt::print(stderr, "bench_accel: {}\n", e.what());

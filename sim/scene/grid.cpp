@@ -7,6 +7,8 @@
 
 #include <fmt/format.h>
 
+#include "sim/scene/cells.hpp"
+
 namespace tpsim::scene {
 
 namespace {
@@ -64,7 +66,6 @@ std::array<uint32_t, 3> density_resolution(const std::array<double, 3>& extent, 
 }  // namespace
 
 Grid build_grid(std::span<const Triangle> triangles, const GridConfig& config) {
-    if (triangles.empty()) throw std::invalid_argument("build_grid: no triangles");
     if (config.resolution > kGridMaxResolution)
         throw std::invalid_argument(
             fmt::format("grid resolution {} is more than the {} cells per axis tpsim builds",
@@ -74,22 +75,9 @@ Grid build_grid(std::span<const Triangle> triangles, const GridConfig& config) {
             fmt::format("grid density {} is not in (0, {}] cells per triangle", config.density,
                         kGridMaxDensity));
     Grid grid;
-    glm::vec3 lo(std::numeric_limits<float>::infinity()), hi(-lo);
-    for (const Triangle& t : triangles)
-        for (const glm::vec3& v : {t.v0, t.v1, t.v2}) {
-            if (!(glm::all(glm::lessThanEqual(glm::abs(v), glm::vec3(1e18f)))))
-                throw std::invalid_argument("build_grid: a vertex is beyond +-1e18 (or NaN)");
-            lo = glm::min(lo, v);
-            hi = glm::max(hi, v);
-        }
-    // Pad the box by a little of its largest extent (1 for a point), so a flat scene still has
-    // cells of some thickness and no triangle lies on the box's faces, where rounding decides
-    // whether a ray enters.
-    const glm::vec3 extent = hi - lo;
-    const float longest = std::max({extent.x, extent.y, extent.z});
-    const float pad = longest > 0 ? longest * 1e-4f : 1.0f;
-    grid.lo = lo - glm::vec3(pad) - glm::abs(lo) * 1e-6f;
-    grid.hi = hi + glm::vec3(pad) + glm::abs(hi) * 1e-6f;
+    const Aabb box = padded_cells_box(triangles, "build_grid");
+    grid.lo = box.lo;
+    grid.hi = box.hi;
     const glm::vec3 size = grid.hi - grid.lo;
     const float size_longest = std::max({size.x, size.y, size.z});
 

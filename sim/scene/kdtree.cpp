@@ -11,6 +11,8 @@
 #include <fmt/format.h>
 #include <oneapi/tbb/parallel_invoke.h>
 
+#include "sim/scene/cells.hpp"
+
 namespace tpsim::scene {
 
 namespace {
@@ -205,7 +207,6 @@ void fill_stats(KdTree& tree) {
 }  // namespace
 
 KdTree build_kdtree(std::span<const Triangle> triangles, const KdTreeConfig& config) {
-    if (triangles.empty()) throw std::invalid_argument("kd-tree: the scene has no triangles");
     if (!(config.max_references_per_triangle >= 1))
         throw std::invalid_argument(
             fmt::format("kd-tree: max_references_per_triangle must be >= 1, got {}",
@@ -213,21 +214,8 @@ KdTree build_kdtree(std::span<const Triangle> triangles, const KdTreeConfig& con
     if (config.max_depth > kKdMaxDepth)
         throw std::invalid_argument(fmt::format("kd-tree: max_depth must be in 1..{}, got {}",
                                                 kKdMaxDepth, config.max_depth));
-    glm::vec3 lo(std::numeric_limits<float>::infinity()), hi(-lo);
-    for (const Triangle& t : triangles)
-        for (const glm::vec3& v : {t.v0, t.v1, t.v2}) {
-            if (!glm::all(glm::lessThanEqual(glm::abs(v), glm::vec3(1e18f))))
-                throw std::invalid_argument("kd-tree: a vertex is beyond +-1e18 (or NaN)");
-            lo = glm::min(lo, v);
-            hi = glm::max(hi, v);
-        }
     KdTree tree;
-    // Padded as the grid's box: no triangle on a face, some thickness for a flat scene.
-    const glm::vec3 extent = hi - lo;
-    const float longest = std::max({extent.x, extent.y, extent.z});
-    const float pad = longest > 0 ? longest * 1e-4f : 1.0f;
-    tree.bounds.lo = lo - glm::vec3(pad) - glm::abs(lo) * 1e-6f;
-    tree.bounds.hi = hi + glm::vec3(pad) + glm::abs(hi) * 1e-6f;
+    tree.bounds = padded_cells_box(triangles, "kd-tree");
     const uint32_t limit =
         config.max_depth != 0
             ? config.max_depth

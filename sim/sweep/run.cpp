@@ -51,6 +51,7 @@ render::RenderOptions render_options(const JobRun& run) {
     options.grid.density = run.grid_density;
     options.kdtree.max_depth = run.kdtree_max_depth;
     options.kdtree.max_references_per_triangle = run.kdtree_max_references;
+    options.octree.max_depth = run.octree_max_depth;
     options.image_width = run.width;
     options.image_height = run.height;
     options.samples_per_pixel = run.spp;

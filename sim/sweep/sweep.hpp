@@ -29,6 +29,7 @@ struct JobRun {
     double grid_density = 4.0;          ///< scene::GridConfig::density
     uint32_t kdtree_max_depth = 0;      ///< scene::KdTreeConfig::max_depth
     double kdtree_max_references = 64;  ///< scene::KdTreeConfig::max_references_per_triangle
+    uint32_t octree_max_depth = 0;      ///< scene::OctreeConfig::max_depth
     std::string bvh = "sweep";          ///< BVH builder: sweep, binned or median
     uint32_t max_leaf = 8;
     std::string bvh_order = "breadth-first";  ///< scene::BvhOrder, as to_string names it
@@ -86,6 +87,7 @@ inline constexpr const char* kRunSettings[] = {"scene",
                                                "grid_density",
                                                "kdtree_max_depth",
                                                "kdtree_max_references",
+                                               "octree_max_depth",
                                                "bvh",
                                                "max_leaf",
                                                "bvh_order",

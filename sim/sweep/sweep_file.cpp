@@ -14,6 +14,7 @@
 #include "sim/scene/bvh.hpp"
 #include "sim/scene/grid.hpp"
 #include "sim/scene/kdtree.hpp"
+#include "sim/scene/octree.hpp"
 #include "sim/sweep/sweep.hpp"
 
 namespace tpsim::sweep {
@@ -22,7 +23,7 @@ namespace {
 constexpr std::uintmax_t kMaxSweepFileBytes = 1 << 20;
 /// More jobs than this is a mistake in the file, not a study (each job is one render).
 constexpr size_t kMaxJobs = 100000;
-constexpr int kPlanVersion = 2;
+constexpr int kPlanVersion = 3;
 
 /// A setting's value and the line it is written on.
 struct Value {
@@ -262,6 +263,8 @@ private:
             run.kdtree_max_depth = uint32_t(integer(name, v, 0, scene::kKdMaxDepth));
         } else if (name == "kdtree_max_references") {
             run.kdtree_max_references = number(name, v, 1.0, 1e6);
+        } else if (name == "octree_max_depth") {
+            run.octree_max_depth = uint32_t(integer(name, v, 0, scene::kOctreeMaxDepth));
         } else if (name == "bvh") {
             run.bvh = one_of(name, v, scene::bvh_builder_names());
         } else if (name == "bvh_order") {
@@ -506,6 +509,7 @@ void write_plan(const Sweep& sweep, const std::filesystem::path& dir) {
                           {"grid_density", r.grid_density},
                           {"kdtree_max_depth", r.kdtree_max_depth},
                           {"kdtree_max_references", r.kdtree_max_references},
+                          {"octree_max_depth", r.octree_max_depth},
                           {"bvh", r.bvh},
                           {"max_leaf", r.max_leaf},
                           {"bvh_order", r.bvh_order},
@@ -578,6 +582,7 @@ Sweep read_plan(const std::filesystem::path& dir) {
             job.run.grid_density = r.at("grid_density").get<double>();
             job.run.kdtree_max_depth = r.at("kdtree_max_depth").get<uint32_t>();
             job.run.kdtree_max_references = r.at("kdtree_max_references").get<double>();
+            job.run.octree_max_depth = r.at("octree_max_depth").get<uint32_t>();
             job.run.bvh = r.at("bvh").get<std::string>();
             job.run.max_leaf = r.at("max_leaf").get<uint32_t>();
             job.run.bvh_order = r.at("bvh_order").get<std::string>();

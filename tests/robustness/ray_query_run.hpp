@@ -1,6 +1,7 @@
 // The harness both robustness tests share: every acceleration structure (and box format) built
 // for a mesh, and its ray_query kernel (ray_query through the BVH, ray_query_wide through the
-// wide BVHs, ray_query_grid through the uniform grid, ray_query_kdtree through the kd-tree) over a
+// wide BVHs, ray_query_grid through the uniform grid, ray_query_kdtree through the kd-tree,
+// ray_query_octree through the octree, ray_query_packet in packets through the BVH) over a
 // batch of rays, on the functional simulator and on the native twin, whose results must agree bit
 // for bit.
 #pragma once
@@ -40,10 +41,11 @@ inline std::string to_string(AccelVariant v) {
 /// Every structure tpsim builds, every wide BVH in both box formats, the binary BVH also in
 /// packets.
 inline constexpr AccelVariant kAccelVariants[] = {
-    {scene::AccelStructure::bvh2}, {scene::AccelStructure::bvh2, scene::BvhBoxes::floats, true},
-    {scene::AccelStructure::bvh4}, {scene::AccelStructure::bvh4, scene::BvhBoxes::quantized},
-    {scene::AccelStructure::bvh8}, {scene::AccelStructure::bvh8, scene::BvhBoxes::quantized},
-    {scene::AccelStructure::grid}, {scene::AccelStructure::kdtree},
+    {scene::AccelStructure::bvh2},   {scene::AccelStructure::bvh2, scene::BvhBoxes::floats, true},
+    {scene::AccelStructure::bvh4},   {scene::AccelStructure::bvh4, scene::BvhBoxes::quantized},
+    {scene::AccelStructure::bvh8},   {scene::AccelStructure::bvh8, scene::BvhBoxes::quantized},
+    {scene::AccelStructure::grid},   {scene::AccelStructure::kdtree},
+    {scene::AccelStructure::octree},
 };
 
 /// A structure built for a mesh as render() builds it (the BVH with the kernels' depth limit).
@@ -53,6 +55,7 @@ struct BuiltAccel {
     std::optional<scene::WideBvh> wide;
     std::optional<scene::Grid> grid;
     std::optional<scene::KdTree> kdtree;
+    std::optional<scene::Octree> octree;
 
     BuiltAccel(const std::vector<scene::Triangle>& mesh, AccelVariant v) : variant(v) {
         if (v.structure == scene::AccelStructure::grid) {
@@ -61,6 +64,10 @@ struct BuiltAccel {
         }
         if (v.structure == scene::AccelStructure::kdtree) {
             kdtree = scene::build_kdtree(mesh);
+            return;
+        }
+        if (v.structure == scene::AccelStructure::octree) {
+            octree = scene::build_octree(mesh);
             return;
         }
         scene::BvhConfig config;
@@ -74,6 +81,7 @@ struct BuiltAccel {
     image::Accel accel() const {
         if (grid) return &*grid;
         if (kdtree) return &*kdtree;
+        if (octree) return &*octree;
         if (wide) return {&*wide, scene::BvhOrder::breadth_first, variant.boxes};
         return &*bvh;
     }
@@ -89,6 +97,7 @@ struct BuiltAccel {
         if (bvh) return bvh->nodes.size();
         if (wide) return 1 + uint64_t(wide->nodes.size()) * wide->stats.width;
         if (kdtree) return kdtree->nodes.size();
+        if (octree) return octree->nodes.size();
         return uint64_t(grid->stats.resolution[0]) + grid->stats.resolution[1] +
                grid->stats.resolution[2] - 2;
     }
@@ -96,6 +105,7 @@ struct BuiltAccel {
         return grid              ? "ray_query_grid.elf"
                : wide            ? "ray_query_wide.elf"
                : kdtree          ? "ray_query_kdtree.elf"
+               : octree          ? "ray_query_octree.elf"
                : variant.packets ? "ray_query_packet.elf"
                                  : "ray_query.elf";
     }

@@ -279,6 +279,11 @@ TEST_CASE("robustness: axis-aligned rays with the origin on BVH box and grid cel
     } else if (variant.structure == AccelStructure::kdtree) {
         for (const scene::KdNode& node : scene::build_kdtree(cube).nodes)
             if (!node.is_leaf()) planes[node.axis].push_back(node.split);
+    } else if (variant.structure == AccelStructure::octree) {
+        for (const scene::OctreeNode& node : scene::build_octree(cube).nodes)
+            if (!node.leaf)
+                for (int axis = 0; axis < 3; ++axis)
+                    planes[size_t(axis)].push_back(node.centre[size_t(axis)]);
     } else if (scene::wide_bvh_width(variant.structure) != 0) {
         // The child boxes as the kernel decodes them (quantized ones lie on their own grid).
         const test::BuiltAccel built(cube, variant);

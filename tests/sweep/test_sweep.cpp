@@ -155,7 +155,8 @@ TEST_CASE("sweep: bad sweep files are one line naming file:line", "[sweep]") {
     CHECK(error_of(dir, "scene = \"scenes/a.toml\"\nl1.size_bites = [1024]\n") ==
           file + ":2: unknown setting 'l1.size_bites': give a run setting (scene, kernel, "
                  "config, accel, grid_resolution, grid_density, kdtree_max_depth, "
-                 "kdtree_max_references, bvh, max_leaf, bvh_order, bvh_align_pairs, bvh_boxes, "
+                 "kdtree_max_references, octree_max_depth, bvh, max_leaf, bvh_order, "
+                 "bvh_align_pairs, bvh_boxes, "
                  "width, height, spp, seed, timing), a chip "
                  "configuration key such as l1.size_bytes (configs/trax.toml lists them), or "
                  "zip");
@@ -229,7 +230,7 @@ l2.size_bytes = [4096, 8192]
     CHECK_THROWS_WITH(read_plan(dir), Catch::Contains("is not a sweep's results directory"));
     std::ofstream(plan_path(dir / "results")) << "{\"format\": \"tpsim-sweep\", \"version\": 7}";
     CHECK_THROWS_WITH(read_plan(dir / "results"),
-                      Catch::Contains("written by plan version 7; this tpsim reads version 2"));
+                      Catch::Contains("written by plan version 7; this tpsim reads version 3"));
 }
 
 TEST_CASE("sweep: finished, pending and failed jobs; collect reads the statistics files",

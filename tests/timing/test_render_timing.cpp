@@ -143,9 +143,9 @@ TEST_CASE("BVH node orders move the traffic, never the image or the instructions
 
 namespace {
 
-/// The small Cornell box on the tiny chip through another structure's tracer. The wide BVH's
-/// and the kd-tree's traversal stacks (64 and 40 entries) do not fit the tiny chip's 1 KiB of
-/// local store; two TMs give each of two host threads one.
+/// The small Cornell box on the tiny chip through another structure's tracer. The wide BVH's,
+/// the kd-tree's and the octree's traversal stacks (64, 40 and 48 entries) and the packets' rays
+/// do not fit the tiny chip's 1 KiB of local store; two TMs give each of two host threads one.
 render::RenderOptions structure_run(const char* kernel) {
     render::RenderOptions options;
     options.scene = small_cornell();
@@ -237,6 +237,9 @@ TEST_CASE("every key a cycle-level render registers is documented in docs/statis
     // And the kd-tree's.
     CHECK(check_documented(render::render(structure_run("tracer_kdtree.elf")))
               .count("kdtree/references") == 1);
+    // And the octree's.
+    CHECK(check_documented(render::render(structure_run("tracer_octree.elf")))
+              .count("octree/references") == 1);
 }
 
 TEST_CASE("The kd-tree renders the binary BVH's image, the same on one and on two host threads",
@@ -246,6 +249,16 @@ TEST_CASE("The kd-tree renders the binary BVH's image, the same on one and on tw
         render_on_one_and_two_host_threads(structure_run("tracer_kdtree.elf"), reference);
     REQUIRE(result.kdtree);
     CHECK(result.kdtree->references >= result.scene.triangles.size());
+}
+
+TEST_CASE("The octree renders the binary BVH's image, the same on one and on two host threads",
+          "[render][invariance][octree]") {
+    const auto reference = render_cornell(render::Engine::timing, tiny());
+    const auto result =
+        render_on_one_and_two_host_threads(structure_run("tracer_octree.elf"), reference);
+    REQUIRE(result.octree);
+    CHECK(result.octree->references >= result.scene.triangles.size());
+    CHECK(result.octree->interior > 0);
 }
 
 TEST_CASE("Packets render the single-ray kernels' images, the same on one and on two host "
