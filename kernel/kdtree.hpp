@@ -3,17 +3,44 @@
 // each plane it crosses, the near side walked first and the far side pushed with its part of
 // the segment (Havran's thesis, "Heuristic Ray Shooting Algorithms", 2000, the recursive
 // traversal made iterative). A drop-in for BvhTraversal: the same trace(), the same watertight
-// triangle test, so the image is the BVH tracer's.
+// triangle test, so the image is the BVH tracer's. The BSP tree (kAccelBsp, TRAX_USES_BSP) is
+// walked the same way, its planes n.x = split of the kBspDirections orientations: the ray's
+// n.o and n.d are computed once for each.
 #pragma once
 #include "rt.hpp"
 
 namespace trax::rt {
 
-struct KdTreeTraversal {
+/// n.v for every plane orientation of a BSP tree, in kBspDirection's order.
+inline void along_bsp_directions(Vec3 v, float (&out)[kBspDirections]) {
+    const float values[kBspDirections] = {v.x,
+                                          v.y,
+                                          v.z,
+                                          v.x + v.y,
+                                          v.x - v.y,
+                                          v.x + v.z,
+                                          v.x - v.z,
+                                          v.y + v.z,
+                                          v.y - v.z,
+                                          v.x + v.y + v.z,
+                                          v.x + v.y - v.z,
+                                          v.x - v.y + v.z,
+                                          -v.x + v.y + v.z};
+    for (int k = 0; k < kBspDirections; ++k)
+        out[k] = values[k];
+}
+
+/// The walk of a kd-tree (kGeneralPlanes false) or a BSP tree (true): KdTreeTraversal and
+/// BspTraversal below.
+template <bool kGeneralPlanes> struct BasicKdTraversal {
+    static constexpr int kDirections = kGeneralPlanes ? kBspDirections : 3;
+    static constexpr uint32_t kShapeBits = kGeneralPlanes ? kBspShapeBits : 2;
+    static constexpr uint32_t kLeafShape = kGeneralPlanes ? kBspLeaf : kKdLeaf;
+
     int triangles, nodes, refs;
     Vec3 lo, hi;
 
-    static KdTreeTraversal from_scene() {
+    static BasicKdTraversal from_scene() {
         const int record = loadi(0, kHeaderAccel);
         return {trax_triangles(), loadi(record, kAccelNodes), loadi(record, kAccelRefs),
                 load_vec3(record, kAccelBoundsMin), load_vec3(record, kAccelBoundsMax)};
@@ -29,13 +56,20 @@ struct KdTreeTraversal {
         Hit hit;
         hit.t = t_max;
         if (!valid_ray(origin, dir, t_max)) return hit;
-        const float o[3] = {origin.x, origin.y, origin.z};
-        const float d[3] = {dir.x, dir.y, dir.z};
-        const float inv[3] = {1.0f / dir.x, 1.0f / dir.y, 1.0f / dir.z};
+        // The ray's n.o, n.d and 1 / n.d for every plane orientation, the axes first.
+        float o[kDirections] = {origin.x, origin.y, origin.z};
+        float d[kDirections] = {dir.x, dir.y, dir.z};
+        float inv[kDirections] = {1.0f / dir.x, 1.0f / dir.y, 1.0f / dir.z};
         const float box_lo[3] = {lo.x, lo.y, lo.z}, box_hi[3] = {hi.x, hi.y, hi.z};
         // The segment inside the box, [t_near, t_far].
         float t_near = 0.0f, t_far = t_max;
         if (!clip_to_box(o, inv, box_lo, box_hi, t_near, t_far)) return hit;
+        if constexpr (kGeneralPlanes) {
+            along_bsp_directions(origin, o);
+            along_bsp_directions(dir, d);
+            for (int k = 3; k < kDirections; ++k)
+                inv[k] = 1.0f / d[k];
+        }
         const ShearedRay r = shear(origin, dir);
         int stack_node[kKdStackEntries];
         float stack_near[kKdStackEntries], stack_far[kKdStackEntries];
@@ -45,10 +79,10 @@ struct KdTreeTraversal {
             ++stats.nodes_visited;
             const int address = nodes + node * kKdNodeWords;
             const uint32_t shape = static_cast<uint32_t>(loadi(address, 1));
-            const uint32_t axis = shape & 3u;
-            if (axis != kKdLeaf) {
+            const uint32_t axis = shape & kLeafShape;
+            if (axis != kLeafShape) {
                 const float split = loadf(address, 0);
-                const int left = node + 1, right = static_cast<int>(shape >> 2);
+                const int left = node + 1, right = static_cast<int>(shape >> kShapeBits);
                 const float t_split = (split - o[axis]) * inv[axis];
                 // The side the ray starts on; a ray in the plane goes on along it, in either
                 // side (the builder lists the plane's triangles in both).
@@ -74,7 +108,7 @@ struct KdTreeTraversal {
                 continue;
             }
             const int first_ref = loadi(address, 0);
-            const int end = first_ref + static_cast<int>(shape >> 2);
+            const int end = first_ref + static_cast<int>(shape >> kShapeBits);
             for (int i = first_ref; i < end; ++i) {
                 const int triangle = loadi(refs + i, 0);
                 ++stats.triangles_tested;
@@ -97,5 +131,9 @@ struct KdTreeTraversal {
         }
     }
 };
+
+/// The kd-tree's walk and the BSP tree's (profiles name them BasicKdTraversal<false> and <true>).
+using KdTreeTraversal = BasicKdTraversal<false>;
+using BspTraversal = BasicKdTraversal<true>;
 
 }  // namespace trax::rt

@@ -34,6 +34,8 @@ constexpr const char* kUsesWideBvhSymbol = "trax_uses_wide_bvh";
 constexpr const char* kUsesKdTreeSymbol = "trax_uses_kdtree";
 /// The same for a kernel that traverses the octree (TRAX_USES_OCTREE).
 constexpr const char* kUsesOctreeSymbol = "trax_uses_octree";
+/// The same for a kernel that traverses the BSP tree (TRAX_USES_BSP).
+constexpr const char* kUsesBspSymbol = "trax_uses_bsp";
 /// Name of the marker symbol trax.hpp's emitter and random-number functions leave in a kernel's
 /// ELF: the host adds the SceneExtras sections only for such kernels, so the memory image (and
 /// every statistic) of a kernel that reads neither stays as it was before they existed.
@@ -134,6 +136,7 @@ enum AccelKind : int32_t {
     kAccelWideBvh = 2,
     kAccelKdTree = 3,
     kAccelOctree = 4,
+    kAccelBsp = 5,
 };
 
 /// Entries in the kd-tree traversal stack (kernel/kdtree.hpp): one per level, the host builds
@@ -144,6 +147,19 @@ constexpr int32_t kKdStackEntries = 40;
 /// first of its references and kKdLeaf | count << 2.
 constexpr int32_t kKdNodeWords = 2;
 constexpr uint32_t kKdLeaf = 3;
+
+/// The orientations of a BSP tree's planes n.x = split: the three axes, the six face diagonals
+/// and the four space diagonals of the cube, as integer normals (kernel/kdtree.hpp computes n.v
+/// as the same sums and differences of coordinates).
+constexpr int32_t kBspDirections = 13;
+constexpr int32_t kBspDirection[kBspDirections][3] = {
+    {1, 0, 0}, {0, 1, 0},  {0, 0, 1}, {1, 1, 0},  {1, -1, 0}, {1, 0, 1}, {1, 0, -1},
+    {0, 1, 1}, {0, 1, -1}, {1, 1, 1}, {1, 1, -1}, {1, -1, 1}, {-1, 1, 1}};
+/// BSP nodes are the kd-tree's two words with four bits for the orientation: an interior node
+/// holds split (float) and direction | right child << 4, a leaf its first reference and
+/// kBspLeaf | count << 4.
+constexpr uint32_t kBspShapeBits = 4;
+constexpr uint32_t kBspLeaf = 15;
 
 /// Entries in the octree traversal stack (kernel/octree.hpp): a cell pushes at most the three
 /// octants after the first, the host builds no deeper tree than a third of this
@@ -197,6 +213,8 @@ constexpr int32_t wide_quantized_boxes_byte(int32_t width) {
 /// (kKdNodeWords each, count in words, the root first, depth-first), `refs` the leaves'
 /// triangles (image triangle indices, in scene order; a triangle is listed in every leaf its
 /// bounding box reaches).
+///
+/// BSP tree (kAccelBsp): as the kd-tree, its nodes in the BSP layout (kBspShapeBits).
 ///
 /// Octree (kAccelOctree): the bounds are the root cell; `nodes` holds the nodes
 /// (kOctreeNodeWords each, count in words), `refs` the leaves' triangles (image triangle

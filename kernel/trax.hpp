@@ -145,8 +145,15 @@ TRAX_CSR_FUNCTION(trax_tm_size, 0xCC4)
         ".globl trax_uses_kdtree\n.type trax_uses_kdtree, @function\n"                             \
         "trax_uses_kdtree:\n  ret\n.size trax_uses_kdtree, . - trax_uses_kdtree\n.popsection")
 
-/// Write `TRAX_USES_OCTREE;` at file scope in a kernel that traverses the octree (kernel/
-/// octree.hpp): tpsim then builds the octree (trax::layout::kUsesOctreeSymbol).
+/// Write `TRAX_USES_BSP;` at file scope in a kernel that traverses the BSP tree (kernel/
+/// kdtree.hpp's BspTraversal): tpsim then builds the BSP tree (trax::layout::kUsesBspSymbol).
+/// `TRAX_USES_OCTREE;` does the same for the octree (kernel/octree.hpp). in a kernel that traverses
+/// the octree (kernel/ octree.hpp): tpsim then builds the octree (trax::layout::kUsesOctreeSymbol).
+#define TRAX_USES_BSP                                                                              \
+    asm(".pushsection .text.trax_uses_bsp, \"ax\", @progbits\n"                                    \
+        ".globl trax_uses_bsp\n.type trax_uses_bsp, @function\n"                                   \
+        "trax_uses_bsp:\n  ret\n.size trax_uses_bsp, . - trax_uses_bsp\n.popsection")
+
 #define TRAX_USES_OCTREE                                                                           \
     asm(".pushsection .text.trax_uses_octree, \"ax\", @progbits\n"                                 \
         ".globl trax_uses_octree\n.type trax_uses_octree, @function\n"                             \
@@ -188,6 +195,7 @@ TRAX_INLINE void set_rand_state(uint32_t state) {
 #define TRAX_USES_WIDE_BVH static_assert(true)
 #define TRAX_USES_KDTREE static_assert(true)
 #define TRAX_USES_OCTREE static_assert(true)
+#define TRAX_USES_BSP static_assert(true)
 
 namespace trax::native {
 

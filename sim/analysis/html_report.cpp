@@ -190,6 +190,10 @@ std::string run_line(const StatsFile& run) {
         parts.push_back(fmt::format("kd-tree, depth limit {}", field("kdtree_max_depth") == "0"
                                                                    ? std::string("8 + 1.3 log2 N")
                                                                    : field("kdtree_max_depth")));
+    else if (accel == "bsp")
+        parts.push_back(fmt::format("BSP tree (13 plane orientations), depth limit {}",
+                                    field("kdtree_max_depth") == "0" ? std::string("8 + 1.3 log2 N")
+                                                                     : field("kdtree_max_depth")));
     else if (accel == "octree")
         parts.push_back(fmt::format("octree, depth limit {}", field("octree_max_depth") == "0"
                                                                   ? std::string("the default")

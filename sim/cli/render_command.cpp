@@ -235,7 +235,8 @@ Command add_render_command(CLI::App& app) {
         ->add_option("--accel", o->accel,
                      "Acceleration structure: bvh2 (binary BVH, kernel tracer), bvh4 or bvh8 "
                      "(wide BVHs, kernel tracer_wide), grid (uniform grid, kernel tracer_grid), "
-                     "kdtree (kernel tracer_kdtree) or octree (kernel tracer_octree); with "
+                     "kdtree (kernel tracer_kdtree), bsp (BSP tree with 13 plane orientations, "
+                     "kernel tracer_bsp) or octree (kernel tracer_octree); with "
                      "--kernel, one the kernel traverses (docs/accel.md) [default: the kernel's]")
         ->check(CLI::IsMember(scene::accel_names()));
     command
@@ -250,13 +251,15 @@ Command add_render_command(CLI::App& app) {
         ->check(CLI::Range(1.0 / 1024, scene::kGridMaxDensity))
         ->capture_default_str();
     command
-        ->add_option("--kdtree-max-depth", o->kdtree_max_depth,
-                     "kd-tree: deepest leaf; 0: 8 + 1.3 log2(triangles), Havran's rule")
+        ->add_option(
+            "--kdtree-max-depth", o->kdtree_max_depth,
+            "kd-tree and BSP tree: deepest leaf; 0: 8 + 1.3 log2(triangles), Havran's rule")
         ->check(whole_number_in(0, scene::kKdMaxDepth))
         ->capture_default_str();
     command
         ->add_option("--kdtree-max-references", o->kdtree_max_references,
-                     "kd-tree: most leaf references per triangle, on average, before the build "
+                     "kd-tree and BSP tree: most leaf references per triangle, on average, before "
+                     "the build "
                      "is refused")
         ->check(CLI::Range(1.0, 1e6))
         ->capture_default_str();

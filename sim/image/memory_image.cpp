@@ -340,7 +340,7 @@ MemoryImage build_memory_image(const scene::Scene& scene, Accel accel, uint32_t 
         put(accel_record.bounds_max, wide->bounds.hi);
     }
     if (kdtree != nullptr) {
-        accel_record.kind = layout::kAccelKdTree;
+        accel_record.kind = kdtree->general_planes ? layout::kAccelBsp : layout::kAccelKdTree;
         accel_record.nodes.count =
             checked_count(kdtree->nodes.size() * layout::kKdNodeWords, "kd-tree node words");
         accel_record.refs.count = checked_count(kdtree->references.size(), "kd-tree references");
@@ -448,13 +448,16 @@ MemoryImage build_memory_image(const scene::Scene& scene, Accel accel, uint32_t 
     if (kdtree != nullptr) {
         write(image.words, h.accel, accel_record);
         uint32_t* out = image.words.data() + accel_record.nodes.addr;
+        // The kd-tree's two bits of axis, or the BSP tree's four of orientation.
+        const uint32_t bits = kdtree->general_planes ? layout::kBspShapeBits : 2;
+        const uint32_t leaf = kdtree->general_planes ? layout::kBspLeaf : layout::kKdLeaf;
         for (const scene::KdNode& node : kdtree->nodes) {
             if (node.is_leaf()) {
                 out[0] = node.first;
-                out[1] = layout::kKdLeaf | node.count << 2;
+                out[1] = leaf | node.count << bits;
             } else {
                 std::memcpy(&out[0], &node.split, 4);
-                out[1] = node.axis | node.right_child << 2;
+                out[1] = node.axis | node.right_child << bits;
             }
             out += layout::kKdNodeWords;
         }
@@ -520,11 +523,13 @@ MemoryImage build_memory_image(const scene::Scene& scene, Accel accel, uint32_t 
         image.sections.push_back(section("grid_refs", accel_record.refs, 1));
     }
     if (kdtree != nullptr) {
-        image.sections.push_back({"kdtree", 1, sizeof(accel_record), uint64_t(h.accel) * 4});
-        image.sections.push_back({"kdtree_nodes", uint32_t(kdtree->nodes.size()),
-                                  uint64_t(accel_record.nodes.count) * 4,
-                                  uint64_t(accel_record.nodes.addr) * 4});
-        image.sections.push_back(section("kdtree_refs", accel_record.refs, 1));
+        const bool bsp = kdtree->general_planes;
+        image.sections.push_back(
+            {bsp ? "bsp" : "kdtree", 1, sizeof(accel_record), uint64_t(h.accel) * 4});
+        image.sections.push_back(
+            {bsp ? "bsp_nodes" : "kdtree_nodes", uint32_t(kdtree->nodes.size()),
+             uint64_t(accel_record.nodes.count) * 4, uint64_t(accel_record.nodes.addr) * 4});
+        image.sections.push_back(section(bsp ? "bsp_refs" : "kdtree_refs", accel_record.refs, 1));
     }
     if (octree != nullptr) {
         image.sections.push_back({"octree", 1, sizeof(accel_record), uint64_t(h.accel) * 4});

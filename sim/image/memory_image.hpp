@@ -80,7 +80,8 @@ std::vector<uint32_t> compile_wide_bvh(const scene::WideBvh& bvh, scene::BvhOrde
 /// ("bvh_root") and the wide nodes ("bvh_nodes", the binary BVH's region name, so that traffic
 /// compares across widths), triangles in leaf order. With a kd-tree, the AccelRecord and its
 /// nodes and references ("kdtree", "kdtree_nodes", "kdtree_refs"), triangles in scene order; the
-/// same for an octree ("octree", "octree_nodes", "octree_refs").
+/// same for an octree ("octree", "octree_nodes", "octree_refs") and a BSP tree ("bsp",
+/// "bsp_nodes", "bsp_refs").
 /// One zeroed ThreadStats record per thread (`threads` of them); `rays` (for the ray_query
 /// kernel) and room for as many RayResults. With `extras_seed`, also the SceneExtras record
 /// (that run seed, every material's emission, the emissive triangles): only for kernels that

@@ -237,10 +237,12 @@ RenderResult render(const RenderOptions& options) {
         grid = timed_build(result.grid_seconds,
                            [&] { return scene::build_grid(result.scene.triangles, options.grid); });
         result.grid = grid->stats;
-    } else if (result.accel == scene::AccelStructure::kdtree) {
-        kdtree = timed_build(result.kdtree_seconds, [&] {
-            return scene::build_kdtree(result.scene.triangles, options.kdtree);
-        });
+    } else if (result.accel == scene::AccelStructure::kdtree ||
+               result.accel == scene::AccelStructure::bsp) {
+        scene::KdTreeConfig config = options.kdtree;
+        config.general_planes = result.accel == scene::AccelStructure::bsp;
+        kdtree = timed_build(result.kdtree_seconds,
+                             [&] { return scene::build_kdtree(result.scene.triangles, config); });
         result.kdtree = kdtree->stats;
     } else if (result.accel == scene::AccelStructure::octree) {
         octree = timed_build(result.octree_seconds, [&] {

@@ -94,7 +94,8 @@ struct RenderOptions {
     scene::BvhConfig bvh;
     /// The grid to build when the kernel traverses one (TRAX_USES_GRID).
     scene::GridConfig grid;
-    /// The kd-tree to build when the kernel traverses one (TRAX_USES_KDTREE).
+    /// The kd-tree to build when the kernel traverses one (TRAX_USES_KDTREE), or the BSP tree
+    /// (TRAX_USES_BSP; render() sets general_planes).
     scene::KdTreeConfig kdtree;
     /// The octree to build when the kernel traverses one (TRAX_USES_OCTREE).
     scene::OctreeConfig octree;
@@ -144,7 +145,7 @@ struct RenderResult {
     std::optional<scene::BvhStats> bvh;
     std::optional<scene::WideBvhStats> wide_bvh;  ///< when a wide BVH was built
     std::optional<scene::GridStats> grid;         ///< when a grid was built
-    std::optional<scene::KdTreeStats> kdtree;     ///< when a kd-tree was built
+    std::optional<scene::KdTreeStats> kdtree;     ///< when a kd-tree or BSP tree was built
     std::optional<scene::OctreeStats> octree;     ///< when an octree was built
     image::MemoryImage image;                     ///< the memory image after the run
     image::TraversalTotals traversal;             ///< the kernel's per-thread statistics, summed

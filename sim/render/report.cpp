@@ -263,29 +263,37 @@ void register_stats(const RenderResult& r, stats::Registry& reg) {
             "host/grid_seconds", [&r] { return r.grid_seconds; }, "grid build time", "s");
     }
     if (r.kdtree) {
+        // The kd-tree's keys, or the BSP tree's (the same builder).
         const scene::KdTreeStats& k = *r.kdtree;
+        const std::string prefix(scene::to_string(r.accel));
+        const std::string tree = r.accel == scene::AccelStructure::bsp ? "BSP tree" : "kd-tree";
         number(
-            "kdtree/nodes", [&k] { return k.nodes; }, "kd-tree nodes (interior + leaves)");
+            prefix + "/nodes", [&k] { return k.nodes; }, tree + " nodes (interior + leaves)");
         number(
-            "kdtree/leaves", [&k] { return k.leaves; }, "kd-tree leaves");
+            prefix + "/leaves", [&k] { return k.leaves; }, tree + " leaves");
         number(
-            "kdtree/empty_leaves", [&k] { return k.empty_leaves; },
-            "kd-tree leaves with no triangle");
+            prefix + "/empty_leaves", [&k] { return k.empty_leaves; },
+            tree + " leaves with no triangle");
         number(
-            "kdtree/max_depth", [&k] { return k.max_depth; },
+            prefix + "/max_depth", [&k] { return k.max_depth; },
             "edges from the root to the deepest leaf");
         number(
-            "kdtree/references", [&k] { return k.references; },
+            prefix + "/references", [&k] { return k.references; },
             "leaf entries (a triangle in k leaves counts k)");
         number(
-            "kdtree/references_per_triangle",
+            prefix + "/references_per_triangle",
             [&k, &r] { return double(k.references) / double(r.scene.triangles.size()); },
             "leaves a triangle is listed in, on average");
         number(
-            "kdtree/max_leaf_triangles", [&k] { return k.max_leaf_triangles; },
+            prefix + "/max_leaf_triangles", [&k] { return k.max_leaf_triangles; },
             "most triangles listed in one leaf");
+        if (r.accel == scene::AccelStructure::bsp)
+            number(
+                "bsp/diagonal_planes", [&k] { return k.diagonal_planes; },
+                "interior nodes whose plane is a face or space diagonal's, not an axis's");
         number(
-            "host/kdtree_seconds", [&r] { return r.kdtree_seconds; }, "kd-tree build time", "s");
+            "host/" + prefix + "_seconds", [&r] { return r.kdtree_seconds; }, tree + " build time",
+            "s");
     }
     if (r.octree) {
         const scene::OctreeStats& o = *r.octree;
@@ -501,11 +509,15 @@ void print_summary(const RenderOptions& options, const RenderResult& r,
     if (r.kdtree) {
         const scene::KdTreeStats& k = *r.kdtree;
         fmt::print(out,
-                   "kdtree   {} nodes, {} leaves ({} empty), depth {} (limit {}), {} references "
+                   "{:<8} {} nodes, {} leaves ({} empty), depth {} (limit {}), {} references "
                    "({:.2f} per triangle), at most {} in a leaf, built in {:.3f} s\n",
-                   k.nodes, k.leaves, k.empty_leaves, k.max_depth, k.depth_limit, k.references,
+                   scene::to_string(r.accel), k.nodes, k.leaves, k.empty_leaves, k.max_depth,
+                   k.depth_limit, k.references,
                    double(k.references) / double(r.scene.triangles.size()), k.max_leaf_triangles,
                    r.kdtree_seconds);
+        if (r.accel == scene::AccelStructure::bsp)
+            fmt::print(out, "         {} of {} planes diagonal\n", k.diagonal_planes,
+                       k.nodes - k.leaves);
     }
     if (r.octree) {
         const scene::OctreeStats& o = *r.octree;

@@ -1,6 +1,6 @@
 // The acceleration structures tpsim builds for a kernel: which one follows from the marker the
 // kernel's ELF defines (TRAX_USES_BVH, TRAX_USES_WIDE_BVH, TRAX_USES_GRID, TRAX_USES_KDTREE,
-// TRAX_USES_OCTREE);
+// TRAX_USES_OCTREE, TRAX_USES_BSP);
 // `render --accel` and the sweep key `accel` name one (for a marker that several share, the one to
 // build) and pick its default kernel.
 #pragma once
@@ -22,6 +22,7 @@ enum class AccelStructure {
     grid,    ///< the uniform grid (sim/scene/grid.hpp)
     kdtree,  ///< the kd-tree (sim/scene/kdtree.hpp)
     octree,  ///< the octree (sim/scene/octree.hpp)
+    bsp,     ///< the BSP tree with general planes (sim/scene/kdtree.hpp, general_planes)
 };
 
 struct AccelInfo {
@@ -46,6 +47,8 @@ constexpr std::array kAccelStructures = {
               "the kd-tree"},
     AccelInfo{AccelStructure::octree, "octree", "tracer_octree", trax::layout::kUsesOctreeSymbol,
               "the octree"},
+    AccelInfo{AccelStructure::bsp, "bsp", "tracer_bsp", trax::layout::kUsesBspSymbol,
+              "the BSP tree"},
 };
 
 constexpr AccelInfo accel_info(AccelStructure structure) {

@@ -19,12 +19,75 @@ namespace {
 
 constexpr int kBins = 32;
 constexpr double kTraversalCost = 15, kIntersectionCost = 20, kEmptyBonus = 0.8;
+/// BSP splits on one path that left one side with all of the node's triangles: past this many
+/// the node stays a leaf. Around a vertex where many triangles meet no plane separates them,
+/// yet, cells measured by boxes, each cut pays by the heuristic (the octree's rule; pbrt's
+/// kd-tree limits its "bad refines" the same way).
+constexpr uint32_t kMaxBadCuts = 2;
 /// Subtrees with fewer references than this are built on the calling thread.
 constexpr size_t kParallelReferences = 4096;
 
 double area(const glm::vec3& lo, const glm::vec3& hi) {
     const glm::dvec3 d = glm::max(glm::dvec3(hi) - glm::dvec3(lo), glm::dvec3(0));
     return 2 * (d.x * d.y + d.y * d.z + d.z * d.x);
+}
+
+/// n.p for the plane orientation n = kBspDirection[direction], in double (exact for the axes).
+double project(uint32_t direction, const glm::dvec3& p) {
+    const auto& n = trax::layout::kBspDirection[direction];
+    return double(n[0]) * p.x + double(n[1]) * p.y + double(n[2]) * p.z;
+}
+
+/// The range of n.x over `box` for orientation `direction`.
+std::pair<double, double> project(uint32_t direction, const Aabb& box) {
+    if (direction < 3) return {box.lo[int(direction)], box.hi[int(direction)]};
+    const auto& n = trax::layout::kBspDirection[direction];
+    double lo = 0, hi = 0;
+    for (int a = 0; a < 3; ++a) {
+        lo += n[a] * double(n[a] > 0 ? box.lo[a] : box.hi[a]);
+        hi += n[a] * double(n[a] > 0 ? box.hi[a] : box.lo[a]);
+    }
+    return {lo, hi};
+}
+
+/// The box of the part of `box` below (n.x <= split) or above the plane: exact for an axis; for
+/// a diagonal, the box of the clipped corners and edge crossings, rounded outwards.
+Aabb half_box(const Aabb& box, uint32_t direction, float split, bool above) {
+    Aabb out = box;
+    if (direction < 3) {
+        (above ? out.lo : out.hi)[int(direction)] = split;
+        return out;
+    }
+    glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
+    const auto keep = [&](const glm::dvec3& p) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    };
+    const auto side = [&](const glm::dvec3& p) {
+        const double s = project(direction, p) - double(split);
+        return above ? s >= 0 : s <= 0;
+    };
+    const auto corner = [&](int c) {
+        return glm::dvec3(c & 1 ? box.hi.x : box.lo.x, c & 2 ? box.hi.y : box.lo.y,
+                          c & 4 ? box.hi.z : box.lo.z);
+    };
+    for (int c = 0; c < 8; ++c) {
+        const glm::dvec3 p = corner(c);
+        if (side(p)) keep(p);
+        for (int a = 0; a < 3; ++a) {  // the edge from corner c along axis a, once
+            if (c >> a & 1) continue;
+            const glm::dvec3 q = corner(c | 1 << a);
+            const double sp = project(direction, p) - double(split);
+            const double sq = project(direction, q) - double(split);
+            if ((sp < 0) != (sq < 0)) keep(p + (q - p) * (sp / (sp - sq)));
+        }
+    }
+    if (!(lo.x <= hi.x)) return box;  // nothing on that side (not chosen by the heuristic)
+    for (int a = 0; a < 3; ++a) {
+        out.lo[a] = std::max(box.lo[a], std::nextafter(float(lo[a]), -INFINITY));
+        out.hi[a] = std::min(box.hi[a], std::nextafter(float(hi[a]), INFINITY));
+    }
+    return out;
 }
 
 /// A node as the build makes it, before the tree is laid out depth-first (once, at the end).
@@ -37,58 +100,73 @@ struct BuildNode {
 
 class Builder {
 public:
-    Builder(std::span<const Triangle> triangles, uint32_t depth_limit, double max_per_triangle)
-        : depth_limit_(depth_limit),
+    Builder(std::span<const Triangle> triangles, uint32_t depth_limit, double max_per_triangle,
+            uint32_t directions, const char* name)
+        : name_(name), depth_limit_(depth_limit),
           max_references_(uint64_t(max_per_triangle * double(triangles.size()))),
-          max_per_triangle_(max_per_triangle), lo_(triangles.size()), hi_(triangles.size()) {
+          max_per_triangle_(max_per_triangle), directions_(directions),
+          lo_(triangles.size() * directions), hi_(triangles.size() * directions) {
         for (size_t i = 0; i < triangles.size(); ++i) {
             const Triangle& t = triangles[i];
-            lo_[i] = glm::min(t.v0, glm::min(t.v1, t.v2));
-            hi_[i] = glm::max(t.v0, glm::max(t.v1, t.v2));
+            for (uint32_t k = 0; k < directions; ++k) {
+                const double a = project(k, t.v0), b = project(k, t.v1), c = project(k, t.v2);
+                lo_[i * directions + k] = std::min({a, b, c});
+                hi_[i * directions + k] = std::max({a, b, c});
+            }
         }
     }
 
-    std::unique_ptr<BuildNode> build(const Aabb& box, std::vector<uint32_t> refs,
-                                     uint32_t depth) const {
+    std::unique_ptr<BuildNode> build(const Aabb& box, std::vector<uint32_t> refs, uint32_t depth,
+                                     uint32_t bad_cuts) const {
         auto out = std::make_unique<BuildNode>();
         const auto [axis, split] = choose_split(box, refs, depth);
         std::vector<uint32_t> left, right;
         if (axis >= 0) {
+            const auto k = uint32_t(axis);
             const glm::vec3 extent = box.hi - box.lo;
-            const float margin = extent[axis] * kKdMargin + std::abs(split) * 0x1p-20f;
+            const auto [lo, hi] = project(k, box);
+            const float width = k < 3 ? extent[axis] : float(hi - lo);
+            const float margin = width * kKdMargin + std::abs(split) * 0x1p-20f;
             for (uint32_t r : refs) {
-                if (lo_[r][axis] <= split + margin) left.push_back(r);
-                if (hi_[r][axis] >= split - margin) right.push_back(r);
+                if (lo_[r * directions_ + k] <= double(split + margin)) left.push_back(r);
+                if (hi_[r * directions_ + k] >= double(split - margin)) right.push_back(r);
             }
         }
+        // A BSP split that leaves one side with every triangle and still gives the other some is
+        // a bad cut (one that cuts off empty space is not); past kMaxBadCuts on a path the node
+        // stays a leaf (the kd-tree builds without this limit).
+        const bool bad = directions_ > 3 && !left.empty() && !right.empty() &&
+                         (left.size() == refs.size() || right.size() == refs.size());
         // The margin puts triangles on or near the plane on both sides, which the binned cost
         // did not count: a split that then costs more than the leaf (or moves nothing) is none.
-        if (axis < 0 || split_cost(box, axis, split, left.size(), right.size()) >=
-                            kIntersectionCost * double(refs.size())) {
+        if (axis < 0 || (bad && bad_cuts == kMaxBadCuts) ||
+            split_cost(box, axis, split, left.size(), right.size()) >=
+                kIntersectionCost * double(refs.size())) {
             // Refused as soon as the leaves hold too many, before they fill the memory.
             const uint64_t total = references_ += refs.size();
             if (total > max_references_)
                 throw std::invalid_argument(fmt::format(
-                    "kd-tree: more than {} leaf references, {:g} per triangle, the limit: the "
+                    "{}: more than {} leaf references, {:g} per triangle, the limit: the "
                     "scene's triangles reach across many leaves; use a BVH (--accel bvh2), "
                     "which references each triangle once",
-                    max_references_, max_per_triangle_));
+                    name_, max_references_, max_per_triangle_));
             out->references = std::move(refs);
             return out;
         }
         refs = {};
-        Aabb left_box = box, right_box = box;
-        left_box.hi[axis] = split;
-        right_box.lo[axis] = split;
+        const Aabb left_box = half_box(box, uint32_t(axis), split, false);
+        const Aabb right_box = half_box(box, uint32_t(axis), split, true);
         out->axis = axis;
         out->split = split;
         if (left.size() + right.size() > kParallelReferences)
             tbb::parallel_invoke(
-                [&] { out->below = build(left_box, std::move(left), depth + 1); },
-                [&] { out->above = build(right_box, std::move(right), depth + 1); });
+                [&] { out->below = build(left_box, std::move(left), depth + 1, bad_cuts + bad); },
+                [&] {
+                    out->above = build(right_box, std::move(right), depth + 1, bad_cuts + bad);
+                });
         else {
-            out->below = build(left_box, std::move(left), depth + 1);
-            out->above = build(right_box, std::move(right), depth + 1);
+            out->below = build(left_box, std::move(left), depth + 1, bad_cuts + bad);
+            out->above = build(right_box, std::move(right), depth + 1, bad_cuts + bad);
         }
         return out;
     }
@@ -102,8 +180,10 @@ private:
         const double box_area = area(box.lo, box.hi);
         double best_cost = kIntersectionCost * n;
         std::pair<int, float> best{-1, 0.f};
-        for (int axis = 0; axis < 3; ++axis) {
-            const double lo = box.lo[axis], extent = double(box.hi[axis]) - lo;
+        for (int axis = 0; axis < int(directions_); ++axis) {
+            const auto k = uint32_t(axis);
+            const auto [lo, hi] = project(k, box);
+            const double extent = hi - lo;
             if (!(extent > 0) || box_area <= 0) continue;
             std::array<uint32_t, kBins> starts{}, ends{};
             const auto bin = [&](float x) {
@@ -111,8 +191,8 @@ private:
                                       double(kBins - 1)));
             };
             for (uint32_t r : refs) {
-                ++starts[size_t(bin(lo_[r][axis]))];
-                ++ends[size_t(bin(hi_[r][axis]))];
+                ++starts[size_t(bin(lo_[r * directions_ + k]))];
+                ++ends[size_t(bin(hi_[r * directions_ + k]))];
             }
             // Plane b lies between bins b - 1 and b: the triangles starting before it reach
             // left, those ending at or after it reach right.
@@ -126,7 +206,7 @@ private:
             for (int b = 1; b < kBins; ++b) {
                 left_count += starts[size_t(b - 1)];
                 const float split = float(lo + extent * b / kBins);
-                if (!(split > box.lo[axis] && split < box.hi[axis])) continue;
+                if (!(split > lo && split < hi)) continue;
                 const double cost =
                     split_cost(box, axis, split, left_count, right_count[size_t(b)]);
                 if (cost < best_cost) {
@@ -140,20 +220,24 @@ private:
 
     /// The SAH cost of splitting `box` at `split` with nl and nr triangles on the two sides.
     static double split_cost(const Aabb& box, int axis, float split, size_t nl, size_t nr) {
-        glm::vec3 left_hi = box.hi, right_lo = box.lo;
-        left_hi[axis] = split;
-        right_lo[axis] = split;
+        // A diagonal plane that cuts off an empty corner leaves the other side's box as it was:
+        // by boxes it would look free, and a chain of them would fill the depth with nothing.
+        if (axis >= 3 && (nl == 0 || nr == 0)) return std::numeric_limits<double>::infinity();
+        const Aabb left = half_box(box, uint32_t(axis), split, false);
+        const Aabb right = half_box(box, uint32_t(axis), split, true);
         const double cost = kTraversalCost + kIntersectionCost *
-                                                 (area(box.lo, left_hi) * double(nl) +
-                                                  area(right_lo, box.hi) * double(nr)) /
+                                                 (area(left.lo, left.hi) * double(nl) +
+                                                  area(right.lo, right.hi) * double(nr)) /
                                                  area(box.lo, box.hi);
         return nl == 0 || nr == 0 ? cost * kEmptyBonus : cost;
     }
 
+    const char* name_;  ///< for messages: "kd-tree" or "BSP tree"
     uint32_t depth_limit_;
     uint64_t max_references_;
     double max_per_triangle_;
-    std::vector<glm::vec3> lo_, hi_;
+    uint32_t directions_;
+    std::vector<double> lo_, hi_;  ///< each triangle's range of n.x, directions_ per triangle
     mutable std::atomic<uint64_t> references_{0};
 };
 
@@ -198,6 +282,7 @@ void fill_stats(KdTree& tree) {
             s.max_leaf_triangles = std::max(s.max_leaf_triangles, node.count);
             s.max_depth = std::max(s.max_depth, depth);
         } else {
+            s.diagonal_planes += node.axis >= 3;
             pending.push_back({node.right_child, depth + 1});
             pending.push_back({index + 1, depth + 1});
         }
@@ -207,15 +292,17 @@ void fill_stats(KdTree& tree) {
 }  // namespace
 
 KdTree build_kdtree(std::span<const Triangle> triangles, const KdTreeConfig& config) {
+    const char* name = config.general_planes ? "BSP tree" : "kd-tree";
     if (!(config.max_references_per_triangle >= 1))
         throw std::invalid_argument(
-            fmt::format("kd-tree: max_references_per_triangle must be >= 1, got {}",
+            fmt::format("{}: max_references_per_triangle must be >= 1, got {}", name,
                         config.max_references_per_triangle));
     if (config.max_depth > kKdMaxDepth)
-        throw std::invalid_argument(fmt::format("kd-tree: max_depth must be in 1..{}, got {}",
+        throw std::invalid_argument(fmt::format("{}: max_depth must be in 1..{}, got {}", name,
                                                 kKdMaxDepth, config.max_depth));
     KdTree tree;
-    tree.bounds = padded_cells_box(triangles, "kd-tree");
+    tree.general_planes = config.general_planes;
+    tree.bounds = padded_cells_box(triangles, name);
     const uint32_t limit =
         config.max_depth != 0
             ? config.max_depth
@@ -225,8 +312,9 @@ KdTree build_kdtree(std::span<const Triangle> triangles, const KdTreeConfig& con
     for (uint32_t i = 0; i < all.size(); ++i)
         all[i] = i;
     const std::unique_ptr<BuildNode> root =
-        Builder(triangles, limit, config.max_references_per_triangle)
-            .build(tree.bounds, std::move(all), 0);
+        Builder(triangles, limit, config.max_references_per_triangle,
+                config.general_planes ? kBspPlaneDirections : 3, name)
+            .build(tree.bounds, std::move(all), 0, 0);
     tree.references.reserve(references_of(*root));
     flatten(*root, tree);
     fill_stats(tree);

@@ -92,8 +92,8 @@ Table collect(const Sweep& sweep, const std::filesystem::path& dir,
             bool any = false;
             for (const char* key :
                  {"host/load_seconds", "host/bvh_seconds", "host/wide_bvh_seconds",
-                  "host/grid_seconds", "host/kdtree_seconds", "host/octree_seconds",
-                  "host/run_seconds"})
+                  "host/grid_seconds", "host/kdtree_seconds", "host/bsp_seconds",
+                  "host/octree_seconds", "host/run_seconds"})
                 if (const auto seconds = run.stat(key)) {
                     host += *seconds;
                     any = true;

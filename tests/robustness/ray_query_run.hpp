@@ -1,9 +1,9 @@
 // The harness both robustness tests share: every acceleration structure (and box format) built
 // for a mesh, and its ray_query kernel (ray_query through the BVH, ray_query_wide through the
 // wide BVHs, ray_query_grid through the uniform grid, ray_query_kdtree through the kd-tree,
-// ray_query_octree through the octree, ray_query_packet in packets through the BVH) over a
-// batch of rays, on the functional simulator and on the native twin, whose results must agree bit
-// for bit.
+// ray_query_octree through the octree, ray_query_bsp through the BSP tree, ray_query_packet in
+// packets through the BVH) over a batch of rays, on the functional simulator and on the native
+// twin, whose results must agree bit for bit.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -45,7 +45,7 @@ inline constexpr AccelVariant kAccelVariants[] = {
     {scene::AccelStructure::bvh4},   {scene::AccelStructure::bvh4, scene::BvhBoxes::quantized},
     {scene::AccelStructure::bvh8},   {scene::AccelStructure::bvh8, scene::BvhBoxes::quantized},
     {scene::AccelStructure::grid},   {scene::AccelStructure::kdtree},
-    {scene::AccelStructure::octree},
+    {scene::AccelStructure::octree}, {scene::AccelStructure::bsp},
 };
 
 /// A structure built for a mesh as render() builds it (the BVH with the kernels' depth limit).
@@ -62,8 +62,11 @@ struct BuiltAccel {
             grid = scene::build_grid(mesh);
             return;
         }
-        if (v.structure == scene::AccelStructure::kdtree) {
-            kdtree = scene::build_kdtree(mesh);
+        if (v.structure == scene::AccelStructure::kdtree ||
+            v.structure == scene::AccelStructure::bsp) {
+            scene::KdTreeConfig config;
+            config.general_planes = v.structure == scene::AccelStructure::bsp;
+            kdtree = scene::build_kdtree(mesh, config);
             return;
         }
         if (v.structure == scene::AccelStructure::octree) {
@@ -102,10 +105,10 @@ struct BuiltAccel {
                grid->stats.resolution[2] - 2;
     }
     const char* kernel() const {
-        return grid              ? "ray_query_grid.elf"
-               : wide            ? "ray_query_wide.elf"
-               : kdtree          ? "ray_query_kdtree.elf"
-               : octree          ? "ray_query_octree.elf"
+        return grid     ? "ray_query_grid.elf"
+               : wide   ? "ray_query_wide.elf"
+               : kdtree ? (kdtree->general_planes ? "ray_query_bsp.elf" : "ray_query_kdtree.elf")
+               : octree ? "ray_query_octree.elf"
                : variant.packets ? "ray_query_packet.elf"
                                  : "ray_query.elf";
     }

@@ -279,6 +279,11 @@ TEST_CASE("robustness: axis-aligned rays with the origin on BVH box and grid cel
     } else if (variant.structure == AccelStructure::kdtree) {
         for (const scene::KdNode& node : scene::build_kdtree(cube).nodes)
             if (!node.is_leaf()) planes[node.axis].push_back(node.split);
+    } else if (variant.structure == AccelStructure::bsp) {
+        scene::KdTreeConfig bsp;
+        bsp.general_planes = true;
+        for (const scene::KdNode& node : scene::build_kdtree(cube, bsp).nodes)
+            if (!node.is_leaf() && node.axis < 3) planes[node.axis].push_back(node.split);
     } else if (variant.structure == AccelStructure::octree) {
         for (const scene::OctreeNode& node : scene::build_octree(cube).nodes)
             if (!node.leaf)

@@ -509,7 +509,8 @@ TEST_CASE("shadow oracle: no holes, false shadows or leaks on the corpus, agains
                                            {AccelStructure::bvh8},
                                            {AccelStructure::grid},
                                            {AccelStructure::kdtree},
-                                           {AccelStructure::octree}};
+                                           {AccelStructure::octree},
+                                           {AccelStructure::bsp}};
     constexpr size_t kVariants = std::size(variants);
     size_t hit_differs = 0, distance_differs = 0, shadow_differs = 0, clear_shadow_differs = 0,
            queries = 0;

@@ -1,8 +1,10 @@
 // The kd-tree builder: every triangle is in every leaf its box reaches, the nodes are the
 // depth-first tree the kernel walks, the build is the same on any number of threads, and the
-// limits are enforced with a clear message.
+// limits are enforced with a clear message; the same for the BSP tree it builds with general
+// planes.
 #include <algorithm>
 #include <random>
+#include <tuple>
 #include <vector>
 
 #include <catch2/catch.hpp>
@@ -126,4 +128,85 @@ TEST_CASE("kd-tree limits: depth, references per triangle, bad input", "[kdtree]
     CHECK_THROWS_WITH(build_kdtree({}), "kd-tree: the scene has no triangles");
     std::vector<Triangle> far = {{{0, 0, 0}, {1, 0, 0}, {0, 1e19f, 0}, 0}};
     CHECK_THROWS_WITH(build_kdtree(far), "kd-tree: a vertex is beyond +-1e18 (or NaN)");
+}
+
+TEST_CASE("Every triangle is in every BSP leaf its projections reach, planes of all 13 "
+          "orientations",
+          "[kdtree][bsp]") {
+    const auto triangles = soup(600, 7, 1.5f);
+    KdTreeConfig config;
+    config.general_planes = true;
+    const KdTree tree = build_kdtree(triangles, config);
+    REQUIRE(tree.general_planes);
+    // n.x over a triangle, as the builder projects it.
+    const auto range = [](const Triangle& t, uint32_t k) {
+        const auto& n = trax::layout::kBspDirection[k];
+        double lo = 1e300, hi = -1e300;
+        for (const glm::vec3& v : {t.v0, t.v1, t.v2}) {
+            const double p = double(n[0]) * v.x + double(n[1]) * v.y + double(n[2]) * v.z;
+            lo = std::min(lo, p);
+            hi = std::max(hi, p);
+        }
+        return std::pair{lo, hi};
+    };
+    // Each leaf with the half-spaces on its path: (orientation, plane, above).
+    struct Item {
+        uint32_t node;
+        std::vector<std::tuple<uint32_t, float, bool>> path;
+    };
+    std::vector<Item> pending{{0, {}}};
+    uint32_t leaves = 0, diagonal = 0;
+    while (!pending.empty()) {
+        Item item = std::move(pending.back());
+        pending.pop_back();
+        const KdNode& node = tree.nodes.at(item.node);
+        if (!node.is_leaf()) {
+            REQUIRE(node.axis < kBspPlaneDirections);
+            diagonal += node.axis >= 3;
+            Item below{item.node + 1, item.path}, above{node.right_child, item.path};
+            below.path.emplace_back(node.axis, node.split, false);
+            above.path.emplace_back(node.axis, node.split, true);
+            pending.push_back(std::move(above));
+            pending.push_back(std::move(below));
+            continue;
+        }
+        ++leaves;
+        const auto begin = tree.references.begin() + node.first;
+        const std::vector<uint32_t> listed(begin, begin + node.count);
+        for (uint32_t i = 0; i < triangles.size(); ++i) {
+            bool reaches = true;
+            for (const auto& [k, split, up] : item.path) {
+                const auto [lo, hi] = range(triangles[i], k);
+                reaches = reaches && (up ? hi >= split : lo <= split);
+            }
+            if (reaches) CHECK(std::count(listed.begin(), listed.end(), i) == 1);
+        }
+    }
+    const KdTreeStats& s = tree.stats;
+    CHECK(s.leaves == leaves);
+    CHECK(s.nodes == 2 * leaves - 1);
+    CHECK(s.diagonal_planes == diagonal);
+    CHECK(s.diagonal_planes > 0);  // the diagonals are used, not only the axes
+    CHECK(s.references >= triangles.size());
+    // The axes-only build of the same soup uses none.
+    CHECK(build_kdtree(triangles).stats.diagonal_planes == 0);
+}
+
+TEST_CASE("The BSP tree is the same on one thread and on many", "[kdtree][bsp]") {
+    const auto triangles = soup(6000, 3, 0.5f);
+    KdTreeConfig config;
+    config.general_planes = true;
+    const KdTree many = build_kdtree(triangles, config);
+    const tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+    const KdTree single = build_kdtree(triangles, config);
+    REQUIRE(single.nodes.size() == many.nodes.size());
+    for (size_t i = 0; i < many.nodes.size(); ++i) {
+        const KdNode &a = many.nodes[i], &b = single.nodes[i];
+        CHECK((a.axis == b.axis && a.split == b.split && a.right_child == b.right_child &&
+               a.first == b.first && a.count == b.count));
+    }
+    CHECK(single.references == many.references);
+    KdTreeConfig tight = config;
+    tight.max_references_per_triangle = 1.01;
+    CHECK_THROWS_WITH(build_kdtree(triangles, tight), Catch::StartsWith("BSP tree: more than"));
 }

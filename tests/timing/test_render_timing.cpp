@@ -237,6 +237,10 @@ TEST_CASE("every key a cycle-level render registers is documented in docs/statis
     // And the kd-tree's.
     CHECK(check_documented(render::render(structure_run("tracer_kdtree.elf")))
               .count("kdtree/references") == 1);
+    // The BSP tree's under its own name.
+    const auto bsp_keys = check_documented(render::render(structure_run("tracer_bsp.elf")));
+    CHECK(bsp_keys.count("bsp/diagonal_planes") == 1);
+    CHECK(bsp_keys.count("kdtree/references") == 0);
     // And the octree's.
     CHECK(check_documented(render::render(structure_run("tracer_octree.elf")))
               .count("octree/references") == 1);
@@ -249,6 +253,16 @@ TEST_CASE("The kd-tree renders the binary BVH's image, the same on one and on tw
         render_on_one_and_two_host_threads(structure_run("tracer_kdtree.elf"), reference);
     REQUIRE(result.kdtree);
     CHECK(result.kdtree->references >= result.scene.triangles.size());
+}
+
+TEST_CASE("The BSP tree renders the binary BVH's image, the same on one and on two host threads",
+          "[render][invariance][bsp]") {
+    const auto reference = render_cornell(render::Engine::timing, tiny());
+    const auto result =
+        render_on_one_and_two_host_threads(structure_run("tracer_bsp.elf"), reference);
+    REQUIRE(result.kdtree);
+    CHECK(result.accel == scene::AccelStructure::bsp);
+    CHECK(result.kdtree->diagonal_planes > 0);
 }
 
 TEST_CASE("The octree renders the binary BVH's image, the same on one and on two host threads",
