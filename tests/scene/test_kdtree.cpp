@@ -3,7 +3,6 @@
 // limits are enforced with a clear message; the same for the BSP tree it builds with general
 // planes.
 #include <algorithm>
-#include <random>
 #include <tuple>
 #include <vector>
 
@@ -11,22 +10,12 @@
 #include <oneapi/tbb/global_control.h>
 
 #include "sim/scene/kdtree.hpp"
+#include "tests/scene/scene_test_util.hpp"
 
 using namespace tpsim::scene;
+using tpsim::scene::testing::soup;
 
 namespace {
-
-std::vector<Triangle> soup(uint32_t count, uint32_t seed, float size) {
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> position(-10.f, 10.f), offset(-size, size);
-    std::vector<Triangle> triangles;
-    for (uint32_t i = 0; i < count; ++i) {
-        const glm::vec3 c(position(rng), position(rng), position(rng));
-        const auto corner = [&] { return c + glm::vec3(offset(rng), offset(rng), offset(rng)); };
-        triangles.push_back({corner(), corner(), corner(), 0});
-    }
-    return triangles;
-}
 
 /// Walks the tree with each node's cell; calls leaf(cell, node) for every leaf.
 template <class Leaf> void walk(const KdTree& tree, Leaf leaf) {

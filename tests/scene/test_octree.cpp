@@ -2,29 +2,18 @@
 // centres into the octants the kernel expects, empty octants are marked, the build is the same
 // on any number of threads, and the limits are enforced with a clear message.
 #include <algorithm>
-#include <random>
 #include <vector>
 
 #include <catch2/catch.hpp>
 #include <oneapi/tbb/global_control.h>
 
 #include "sim/scene/octree.hpp"
+#include "tests/scene/scene_test_util.hpp"
 
 using namespace tpsim::scene;
+using tpsim::scene::testing::soup;
 
 namespace {
-
-std::vector<Triangle> soup(uint32_t count, uint32_t seed, float size) {
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> position(-10.f, 10.f), offset(-size, size);
-    std::vector<Triangle> triangles;
-    for (uint32_t i = 0; i < count; ++i) {
-        const glm::vec3 c(position(rng), position(rng), position(rng));
-        const auto corner = [&] { return c + glm::vec3(offset(rng), offset(rng), offset(rng)); };
-        triangles.push_back({corner(), corner(), corner(), 0});
-    }
-    return triangles;
-}
 
 struct Walked {
     uint32_t interior = 0, leaves = 0, deepest = 0;
