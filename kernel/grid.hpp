@@ -7,14 +7,16 @@
 
 namespace trax::rt {
 
-struct GridTraversal {
+/// kStopAtHit = false is the course experiment without the early stop: every ray walks on to
+/// the far side of the grid, whatever it hit (course/experiments/grid_no_early_stop.cpp).
+template <bool kStopAtHit = true> struct BasicGridTraversal {
     int triangles, cells, refs;
     Vec3 lo, hi, scale, cell_size;
     int res_x, res_y, res_z;
 
-    static GridTraversal from_scene() {
+    static BasicGridTraversal from_scene() {
         const int record = loadi(0, kHeaderAccel);
-        GridTraversal g;
+        BasicGridTraversal g;
         g.triangles = trax_triangles();
         g.cells = loadi(record, kAccelNodes);
         g.refs = loadi(record, kAccelRefs);
@@ -88,7 +90,7 @@ struct GridTraversal {
             // Done when the closest hit so far lies in this cell (or no nearer cell can hold
             // one), or the segment ends in it. A NaN distance never stops the walk early; the
             // walk still ends, as every step moves one cell towards the box's far side.
-            if (t_exit >= hit.t || t_exit > t_leave) return hit;
+            if ((kStopAtHit && t_exit >= hit.t) || t_exit > t_leave) return hit;
             cell[axis] += step[axis];
             if (cell[axis] < 0 || cell[axis] >= res[axis]) return hit;
             t_next[axis] = face_distance(axis, cell[axis], step[axis], o, inv);
@@ -105,5 +107,7 @@ private:
         return (face - o[axis]) * inv[axis];
     }
 };
+
+using GridTraversal = BasicGridTraversal<>;
 
 }  // namespace trax::rt

@@ -32,21 +32,11 @@ struct RenderCommandOptions {
     std::string scene;
     std::string up;
     std::string output;
-    std::string kernel;  // "": the tracer of --accel
-    std::string accel;
-    uint32_t grid_resolution = 0;
-    double grid_density = scene::GridConfig{}.density;
-    uint32_t kdtree_max_depth = 0;
-    double kdtree_max_references = scene::KdTreeConfig{}.max_references_per_triangle;
-    uint32_t octree_max_depth = 0;
+    std::string kernel;          // "": the tracer of the structure asked for
+    scene::AccelSettings accel;  // the options given (--accel, --bvh-order ...), nothing else
     std::vector<std::string> params;
     std::string config;
     std::vector<std::string> overrides;
-    std::string bvh = "sweep";
-    uint32_t max_leaf = 8;
-    std::string bvh_order = scene::to_string(scene::BvhConfig{}.order);
-    bool bvh_align_pairs = false;
-    std::string bvh_boxes = scene::to_string(scene::BvhConfig{}.boxes);
     bool native = false;
     bool no_fork = false;
     std::string timing = "cycle";
@@ -82,17 +72,13 @@ int run_render(RenderCommandOptions& o) {
     options.on_warning = [](const std::string& warning) {
         fmt::print(stderr, "tpsim: warning: {}\n", warning);
     };
-    if (!o.accel.empty()) options.accel = scene::find_accel(o.accel)->structure;
+    options.accel = o.accel;
+    // No kernel: the tracer of the structure --accel or the scene file's [accel] table names.
+    const scene::AccelStructure structure =
+        scene::load_accel_settings(o.scene).under(o.accel).structure.value_or(
+            scene::AccelStructure::bvh2);
     options.kernel = resolve_kernel(
-        !o.kernel.empty()
-            ? o.kernel
-            : std::string(scene::accel_info(options.accel.value_or(scene::AccelStructure::bvh2))
-                              .default_kernel));
-    options.grid.resolution = o.grid_resolution;
-    options.grid.density = o.grid_density;
-    options.kdtree.max_depth = o.kdtree_max_depth;
-    options.kdtree.max_references_per_triangle = o.kdtree_max_references;
-    options.octree.max_depth = o.octree_max_depth;
+        !o.kernel.empty() ? o.kernel : std::string(scene::accel_info(structure).default_kernel));
     options.params = o.params;
     options.engine = o.native             ? render::Engine::native
                      : o.timing != "none" ? render::Engine::timing
@@ -116,11 +102,6 @@ int run_render(RenderCommandOptions& o) {
     options.timeline_interval = o.timeline_cycles;
     if (!o.config.empty()) options.chip = timing::load_config(o.config);
     timing::apply_overrides(options.chip, o.overrides);
-    options.bvh.builder = *scene::find_bvh_builder(o.bvh);
-    options.bvh.max_leaf_size = o.max_leaf;
-    options.bvh.order = *scene::find_bvh_order(o.bvh_order);
-    options.bvh.align_pairs = o.bvh_align_pairs;
-    options.bvh.boxes = *scene::find_bvh_boxes(o.bvh_boxes);
 
     // Bad output paths are found now, not after a render that may take hours.
     const std::filesystem::path output =
@@ -231,43 +212,57 @@ Command add_render_command(CLI::App& app) {
     command->add_option("-k,--kernel", o->kernel,
                         "Built kernel name, or a path to a kernel ELF [default: tracer, or the "
                         "tracer of --accel]");
-    command
-        ->add_option("--accel", o->accel,
-                     "Acceleration structure: bvh2 (binary BVH, kernel tracer), bvh4 or bvh8 "
-                     "(wide BVHs, kernel tracer_wide), grid (uniform grid, kernel tracer_grid), "
-                     "kdtree (kernel tracer_kdtree), bsp (BSP tree with 13 plane orientations, "
-                     "kernel tracer_bsp) or octree (kernel tracer_octree); with "
-                     "--kernel, one the kernel traverses (docs/accel.md) [default: the kernel's]")
-        ->check(CLI::IsMember(scene::accel_names()));
-    command
-        ->add_option("--grid-resolution", o->grid_resolution,
-                     "Uniform grid: cells along the scene's longest axis, the others in "
-                     "proportion; 0: by --grid-density")
+    // Each sets its field of o->accel only when given, so that the scene file's [accel] table
+    // fills in the rest (docs/scenes.md).
+    const auto accel_option = [&]<class T>(std::string name,
+                                           std::optional<T> scene::AccelSettings::*field,
+                                           std::string help) {
+        return command->add_option_function<T>(
+            std::move(name), [o, field](const T& value) { o->accel.*field = value; },
+            std::move(help));
+    };
+    // A choice by name (--accel kdtree), kept as the value `find` makes of it.
+    const auto named_option =
+        [&]<class T>(std::string name, std::optional<T> scene::AccelSettings::*field,
+                     std::optional<T> (*find)(std::string_view),
+                     const std::vector<std::string>& names, std::string help) {
+            return command
+                ->add_option_function<std::string>(
+                    std::move(name),
+                    [o, field, find](const std::string& value) { o->accel.*field = *find(value); },
+                    std::move(help))
+                ->check(CLI::IsMember(names));
+        };
+    named_option("--accel", &scene::AccelSettings::structure, scene::find_accel_structure,
+                 scene::accel_names(),
+                 "Acceleration structure: bvh2 (binary BVH, kernel tracer), bvh4 or bvh8 "
+                 "(wide BVHs, kernel tracer_wide), grid (uniform grid, kernel tracer_grid), "
+                 "kdtree (kernel tracer_kdtree), bsp (BSP tree with 13 plane orientations, "
+                 "kernel tracer_bsp) or octree (kernel tracer_octree); with --kernel, one the "
+                 "kernel traverses (docs/accel.md) [default: the scene file's [accel] "
+                 "structure, else the kernel's]");
+    accel_option("--grid-resolution", &scene::AccelSettings::grid_resolution,
+                 "Uniform grid: cells along the scene's longest axis, the others in "
+                 "proportion; 0: by --grid-density")
         ->check(whole_number_in(0, scene::kGridMaxResolution))
-        ->capture_default_str();
-    command
-        ->add_option("--grid-density", o->grid_density,
-                     "Uniform grid: cells per triangle (cubic cells) when --grid-resolution is 0")
+        ->default_str(fmt::format("{}", scene::GridConfig{}.resolution));
+    accel_option("--grid-density", &scene::AccelSettings::grid_density,
+                 "Uniform grid: cells per triangle (cubic cells) when --grid-resolution is 0")
         ->check(CLI::Range(1.0 / 1024, scene::kGridMaxDensity))
-        ->capture_default_str();
-    command
-        ->add_option(
-            "--kdtree-max-depth", o->kdtree_max_depth,
-            "kd-tree and BSP tree: deepest leaf; 0: 8 + 1.3 log2(triangles), Havran's rule")
+        ->default_str(fmt::format("{}", scene::GridConfig{}.density));
+    accel_option("--kdtree-max-depth", &scene::AccelSettings::kdtree_max_depth,
+                 "kd-tree and BSP tree: deepest leaf; 0: 8 + 1.3 log2(triangles), Havran's rule")
         ->check(whole_number_in(0, scene::kKdMaxDepth))
-        ->capture_default_str();
-    command
-        ->add_option("--kdtree-max-references", o->kdtree_max_references,
-                     "kd-tree and BSP tree: most leaf references per triangle, on average, before "
-                     "the build "
-                     "is refused")
+        ->default_str("0");
+    accel_option("--kdtree-max-references", &scene::AccelSettings::kdtree_max_references,
+                 "kd-tree and BSP tree: most leaf references per triangle, on average, before "
+                 "the build is refused")
         ->check(CLI::Range(1.0, 1e6))
-        ->capture_default_str();
-    command
-        ->add_option("--octree-max-depth", o->octree_max_depth,
-                     fmt::format("Octree: deepest leaf; 0: {}", scene::kOctreeMaxDepth))
+        ->default_str(fmt::format("{}", scene::KdTreeConfig{}.max_references_per_triangle));
+    accel_option("--octree-max-depth", &scene::AccelSettings::octree_max_depth,
+                 fmt::format("Octree: deepest leaf; 0: {}", scene::kOctreeMaxDepth))
         ->check(whole_number_in(0, scene::kOctreeMaxDepth))
-        ->capture_default_str();
+        ->default_str("0");
     command
         ->add_option("-p,--param", o->params,
                      "Set one of the kernel's run-time parameters (TRAX_PARAM), e.g. --param "
@@ -283,29 +278,28 @@ Command add_render_command(CLI::App& app) {
         ->add_option("-s,--set", o->overrides,
                      "Override one chip configuration field, e.g. --set chip.num_tms=8")
         ->allow_extra_args(false);
-    command
-        ->add_option("--bvh", o->bvh,
-                     "BVH builder, used when the kernel traverses a BVH (TRAX_USES_BVH)")
-        ->check(CLI::IsMember(scene::bvh_builder_names()))
-        ->capture_default_str();
-    command->add_option("--max-leaf", o->max_leaf, "Most triangles in one BVH leaf")
+    const scene::BvhConfig bvh_defaults;
+    named_option("--bvh", &scene::AccelSettings::bvh_builder, scene::find_bvh_builder,
+                 scene::bvh_builder_names(),
+                 "BVH builder, used when the kernel traverses a BVH (TRAX_USES_BVH)")
+        ->default_str(scene::to_string(bvh_defaults.builder));
+    accel_option("--max-leaf", &scene::AccelSettings::max_leaf, "Most triangles in one BVH leaf")
         ->check(CLI::Range(1, 8))
-        ->capture_default_str();
-    command
-        ->add_option("--bvh-order", o->bvh_order,
-                     "Order of the BVH nodes in memory (docs/accel.md); moves traffic, never "
-                     "the image")
-        ->check(CLI::IsMember(scene::bvh_order_names()))
-        ->capture_default_str();
-    command->add_flag("--bvh-align-pairs", o->bvh_align_pairs,
-                      "Start every BVH sibling pair on a 64-byte line (docs/accel.md); wide "
-                      "BVH nodes always start on one");
-    command
-        ->add_option("--bvh-boxes", o->bvh_boxes,
-                     "How a wide BVH (--accel bvh4|bvh8) stores its child boxes: float, or "
-                     "quantized to 8 bits per bound (docs/accel.md)")
-        ->check(CLI::IsMember(scene::bvh_boxes_names()))
-        ->capture_default_str();
+        ->default_str(fmt::format("{}", bvh_defaults.max_leaf_size));
+    named_option("--bvh-order", &scene::AccelSettings::bvh_order, scene::find_bvh_order,
+                 scene::bvh_order_names(),
+                 "Order of the BVH nodes in memory (docs/accel.md); moves traffic, never the "
+                 "image")
+        ->default_str(scene::to_string(bvh_defaults.order));
+    command->add_flag_function(
+        "--bvh-align-pairs", [o](int64_t) { o->accel.bvh_align_pairs = true; },
+        "Start every BVH sibling pair on a 64-byte line (docs/accel.md); wide BVH nodes always "
+        "start on one");
+    named_option("--bvh-boxes", &scene::AccelSettings::bvh_boxes, scene::find_bvh_boxes,
+                 scene::bvh_boxes_names(),
+                 "How a wide BVH (--accel bvh4|bvh8) stores its child boxes: float, or quantized "
+                 "to 8 bits per bound (docs/accel.md)")
+        ->default_str(scene::to_string(bvh_defaults.boxes));
     // The same limits as the scene file's [image] keys (docs/scenes.md).
     command->add_option("--width", o->width, "Image width in pixels, instead of the scene's")
         ->check(whole_number_in(1, 16384));

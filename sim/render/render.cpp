@@ -175,26 +175,38 @@ RenderResult render(const RenderOptions& options) {
     if (const std::string warning = check_stack(kernel, options.engine, options.chip);
         !warning.empty() && options.on_warning)
         options.on_warning(warning);
+    // The command's settings over the scene file's [accel] table over the kernel's structure.
+    const scene::AccelSettings settings =
+        scene::load_accel_settings(options.scene).under(options.accel);
+    result.accel_configs = scene::accel_configs(settings);
+    const scene::AccelConfigs& configs = result.accel_configs;
     result.accel = kernel.accel();
-    if (options.accel && !kernel.traverses(*options.accel)) {
+    if (settings.structure && !kernel.traverses(*settings.structure)) {
+        const scene::AccelInfo asked = scene::accel_info(*settings.structure);
         // Every structure the kernel's marker serves (bvh4 and bvh8 share one).
         std::vector<std::string> traversed;
         for (const scene::AccelInfo& info : scene::kAccelStructures)
             if (kernel.traverses(info.structure)) traversed.emplace_back(info.description);
         throw Error(fmt::format(
-            "--accel {} asks for {} but kernel '{}' traverses {}; give a kernel that traverses "
-            "it (e.g. --kernel {}) or leave --accel out",
-            scene::to_string(*options.accel), scene::accel_info(*options.accel).description,
-            kernel.elf.filename().string(),
+            "{} asks for {} but kernel '{}' traverses {}; give a kernel that traverses it (e.g. "
+            "--kernel {}) or {}",
+            options.accel.structure ? fmt::format("--accel {}", asked.name)
+                                    : fmt::format("{}'s [accel] structure = \"{}\"",
+                                                  options.scene.string(), asked.name),
+            asked.description, kernel.elf.filename().string(),
             traversed.empty() ? std::string(scene::accel_info(result.accel).description)
                               : fmt::format("{}", fmt::join(traversed, " or ")),
-            scene::accel_info(*options.accel).default_kernel));
+            asked.default_kernel,
+            options.accel.structure
+                ? std::string("leave --accel out")
+                : fmt::format("--accel {} to build the kernel's", scene::to_string(result.accel))));
     }
-    if (options.accel) result.accel = *options.accel;
+    if (settings.structure) result.accel = *settings.structure;
     const uint32_t width = scene::wide_bvh_width(result.accel);
-    if (options.bvh.boxes == scene::BvhBoxes::quantized && width == 0)
+    if (configs.bvh.boxes == scene::BvhBoxes::quantized && width == 0)
         throw Error(fmt::format("--bvh-boxes quantized applies to the wide BVHs (--accel bvh4 or "
-                                "bvh8), not to {}; leave it out or pick a wide BVH",
+                                "bvh8), not to {}; leave it out (or bvh_boxes in the scene's "
+                                "[accel] table) or pick a wide BVH",
                                 scene::accel_info(result.accel).description));
     std::optional<scene::Bvh> bvh;
     std::optional<scene::WideBvh> wide_bvh;
@@ -203,7 +215,7 @@ RenderResult render(const RenderOptions& options) {
     std::optional<scene::Octree> octree;
     if (result.accel == scene::AccelStructure::bvh2 || width != 0) {
         start = std::chrono::steady_clock::now();
-        scene::BvhConfig config = options.bvh;
+        scene::BvhConfig config = configs.bvh;
         config.traversal_stack_entries = trax::layout::kTraversalStackEntries;
         bvh = scene::build_bvh(result.scene.triangles, config);
         result.bvh_seconds = seconds_since(start);
@@ -235,25 +247,25 @@ RenderResult render(const RenderOptions& options) {
     };
     if (result.accel == scene::AccelStructure::grid) {
         grid = timed_build(result.grid_seconds,
-                           [&] { return scene::build_grid(result.scene.triangles, options.grid); });
+                           [&] { return scene::build_grid(result.scene.triangles, configs.grid); });
         result.grid = grid->stats;
     } else if (result.accel == scene::AccelStructure::kdtree ||
                result.accel == scene::AccelStructure::bsp) {
-        scene::KdTreeConfig config = options.kdtree;
+        scene::KdTreeConfig config = configs.kdtree;
         config.general_planes = result.accel == scene::AccelStructure::bsp;
         kdtree = timed_build(result.kdtree_seconds,
                              [&] { return scene::build_kdtree(result.scene.triangles, config); });
         result.kdtree = kdtree->stats;
     } else if (result.accel == scene::AccelStructure::octree) {
         octree = timed_build(result.octree_seconds, [&] {
-            return scene::build_octree(result.scene.triangles, options.octree);
+            return scene::build_octree(result.scene.triangles, configs.octree);
         });
         result.octree = octree->stats;
     }
     result.threads = options.chip.chip.num_tms * options.chip.chip.tps_per_tm;
-    const image::Accel accel = bvh ? image::Accel(&*bvh, options.bvh.order, options.bvh.align_pairs)
+    const image::Accel accel = bvh ? image::Accel(&*bvh, configs.bvh.order, configs.bvh.align_pairs)
                                : wide_bvh
-                                   ? image::Accel(&*wide_bvh, options.bvh.order, options.bvh.boxes)
+                                   ? image::Accel(&*wide_bvh, configs.bvh.order, configs.bvh.boxes)
                                : grid   ? image::Accel(&*grid)
                                : kdtree ? image::Accel(&*kdtree)
                                : octree ? image::Accel(&*octree)

@@ -19,6 +19,7 @@
 #include "sim/render/native_twin.hpp"
 #include "sim/render/sampling.hpp"
 #include "sim/scene/accel.hpp"
+#include "sim/scene/accel_settings.hpp"
 #include "sim/scene/bvh.hpp"
 #include "sim/scene/grid.hpp"
 #include "sim/scene/load_scene.hpp"
@@ -88,20 +89,14 @@ struct RenderOptions {
     Engine engine = Engine::functional;
     /// Engine::native: in a child process (a crash becomes an error) or in this one (gdb).
     TwinProcess twin_process = TwinProcess::child;
-    /// The BVH to build when the kernel traverses one (its ELF defines the TRAX_USES_BVH
-    /// marker); other kernels get no BVH in their memory image. render() sets the depth limit
-    /// to the kernels' stack capacity (trax::layout::kTraversalStackEntries).
-    scene::BvhConfig bvh;
-    /// The grid to build when the kernel traverses one (TRAX_USES_GRID).
-    scene::GridConfig grid;
-    /// The kd-tree to build when the kernel traverses one (TRAX_USES_KDTREE), or the BSP tree
-    /// (TRAX_USES_BSP; render() sets general_planes).
-    scene::KdTreeConfig kdtree;
-    /// The octree to build when the kernel traverses one (TRAX_USES_OCTREE).
-    scene::OctreeConfig octree;
-    /// The structure the user asked for (render --accel): render() refuses a kernel that
-    /// traverses another. Unset: whichever the kernel traverses (bvh4 for a wide-BVH kernel).
-    std::optional<scene::AccelStructure> accel;
+    /// The structure to build and its settings, as the command asked for them (render --accel,
+    /// --bvh-order ...); what it leaves unset comes from the scene file's [accel] table, then
+    /// from the kernel (the structure it traverses; bvh4 for a wide-BVH kernel) and the
+    /// builders' defaults. Only that structure is built: a kernel that traverses another is
+    /// refused. render() sets the BVH's depth limit to the kernels' stack capacity
+    /// (trax::layout::kTraversalStackEntries); a BSP tree is the kd-tree's builder with
+    /// general planes.
+    scene::AccelSettings accel;
     /// Override the scene file's image size and samples per pixel when non-zero
     /// (render --width/--height/--spp; tests render small images).
     uint32_t image_width = 0, image_height = 0, samples_per_pixel = 0;
@@ -141,6 +136,8 @@ struct KernelRun {
 struct RenderResult {
     scene::Scene scene;                                         ///< as loaded (triangles included)
     scene::AccelStructure accel = scene::AccelStructure::none;  ///< what the kernel traverses
+    /// The builders' settings the run used (RenderOptions::accel over the scene file's).
+    scene::AccelConfigs accel_configs;
     /// When a BVH was built (for a wide BVH, the binary tree it was collapsed from).
     std::optional<scene::BvhStats> bvh;
     std::optional<scene::WideBvhStats> wide_bvh;  ///< when a wide BVH was built

@@ -494,7 +494,7 @@ void print_summary(const RenderOptions& options, const RenderResult& r,
                    "{:<8} {} nodes, {} leaves, depth {}, {:.2f} children per node, {} boxes, "
                    "collapsed in {:.3f} s\n",
                    scene::to_string(r.accel), w.nodes, w.leaves, w.max_depth, w.mean_children,
-                   scene::to_string(options.bvh.boxes), w.collapse_seconds);
+                   scene::to_string(r.accel_configs.bvh.boxes), w.collapse_seconds);
     }
     if (r.grid) {
         const scene::GridStats& g = *r.grid;
@@ -611,19 +611,19 @@ nlohmann::ordered_json stats_document(const RenderOptions& options, const Render
     if (r.timing) run["timing"] = r.timing->sampling ? "sampled" : "cycle";
     run["accel"] = scene::to_string(r.accel);
     if (r.grid) {
-        run["grid_resolution"] = options.grid.resolution;
-        run["grid_density"] = options.grid.density;
+        run["grid_resolution"] = r.accel_configs.grid.resolution;
+        run["grid_density"] = r.accel_configs.grid.density;
     }
     if (r.kdtree) {
-        run["kdtree_max_depth"] = options.kdtree.max_depth;
-        run["kdtree_max_references"] = options.kdtree.max_references_per_triangle;
+        run["kdtree_max_depth"] = r.accel_configs.kdtree.max_depth;
+        run["kdtree_max_references"] = r.accel_configs.kdtree.max_references_per_triangle;
     }
-    if (r.octree) run["octree_max_depth"] = options.octree.max_depth;
-    run["bvh_builder"] = scene::to_string(options.bvh.builder);
-    run["max_leaf"] = options.bvh.max_leaf_size;
-    run["bvh_order"] = scene::to_string(options.bvh.order);
-    run["bvh_align_pairs"] = options.bvh.align_pairs;
-    run["bvh_boxes"] = scene::to_string(options.bvh.boxes);
+    if (r.octree) run["octree_max_depth"] = r.accel_configs.octree.max_depth;
+    run["bvh_builder"] = scene::to_string(r.accel_configs.bvh.builder);
+    run["max_leaf"] = r.accel_configs.bvh.max_leaf_size;
+    run["bvh_order"] = scene::to_string(r.accel_configs.bvh.order);
+    run["bvh_align_pairs"] = r.accel_configs.bvh.align_pairs;
+    run["bvh_boxes"] = scene::to_string(r.accel_configs.bvh.boxes);
     run["width"] = r.scene.width;
     run["height"] = r.scene.height;
     run["samples_per_pixel"] = r.scene.samples_per_pixel;

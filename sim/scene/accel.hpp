@@ -81,4 +81,10 @@ constexpr std::optional<AccelInfo> find_accel(std::string_view name) {
     return std::nullopt;
 }
 
+/// The structure `name` names, or nullopt.
+constexpr std::optional<AccelStructure> find_accel_structure(std::string_view name) {
+    if (const auto info = find_accel(name)) return info->structure;
+    return std::nullopt;
+}
+
 }  // namespace tpsim::scene

@@ -780,8 +780,8 @@ Scene scene_from_mesh(const std::filesystem::path& mesh_path, UpAxis up) {
             source);
     return scene;
 }
-Scene load_scene_file(const std::filesystem::path& toml_path) {
-    const Reader r(toml_path.string());
+/// The scene file parsed, every failure one SceneError line; guarded before toml++ sees it.
+toml::table parse_scene_file(const Reader& r, const std::filesystem::path& toml_path) {
     std::error_code error;
     if (!std::filesystem::exists(toml_path, error))
         throw SceneError(fmt::format("{}: scene file not found", r.file()));
@@ -793,15 +793,49 @@ Scene load_scene_file(const std::filesystem::path& toml_path) {
     } catch (const Error& e) {
         throw SceneError(e.what());
     }
-    toml::table root;
     try {
-        root = toml::parse(text, r.file());
+        return toml::parse(text, r.file());
     } catch (const toml::parse_error& e) {
         r.fail(e.source(), fmt::format("TOML syntax: {}", e.description()));
     }
+}
+
+/// The [accel] table: the structure to build and its settings (accel_settings.hpp).
+AccelSettings read_accel(const Reader& r, const toml::table& root) {
+    AccelSettings settings;
+    const toml::node* node = root.get("accel");
+    if (!node) return settings;
+    for (auto&& [key, value] : r.table(*node, "accel")) {
+        const std::string name = join("accel", key.str());
+        if (!is_accel_setting(key.str()))
+            r.fail(key.source(), fmt::format("unknown key {} (allowed: {})", name,
+                                             fmt::join(accel_setting_names(), ", ")));
+        AccelValue v;
+        if (const auto* text = value.as_string())
+            v = text->get();
+        else if (const auto* whole = value.as_integer())
+            v = whole->get();
+        else if (const auto* real = value.as_floating_point())
+            v = real->get();
+        else if (const auto* flag = value.as_boolean())
+            v = flag->get();
+        else
+            r.fail(value.source(),
+                   fmt::format("{} must be a string, a number or true/false, got {}", name,
+                               type_name(value)));
+        if (const std::string wrong = set_accel_setting(settings, key.str(), v); !wrong.empty())
+            r.fail(value.source(), fmt::format("{} {}", name, wrong));
+    }
+    return settings;
+}
+
+Scene load_scene_file(const std::filesystem::path& toml_path) {
+    const Reader r(toml_path.string());
+    const toml::table root = parse_scene_file(r, toml_path);
     r.allow_keys(root, "",
                  {"name", "image", "shading", "camera", "ambient", "background", "lights",
-                  "materials", "meshes", "generators"});
+                  "materials", "meshes", "generators", "accel"});
+    read_accel(r, root);  // checked here too, so that every scene-file mistake is found on load
     Scene scene;
     scene.name = root.get("name") ? r.text(*root.get("name"), "name") : toml_path.stem().string();
     if (const toml::node* node = root.get("image")) {
@@ -858,6 +892,12 @@ Scene load_scene_file(const std::filesystem::path& toml_path) {
     check_lights(r, *lights, frame, scene.light_falloff);
     compile(scene, geometry.placements, geometry.bounds, *camera, *lights, frame, r.file());
     return scene;
+}
+
+AccelSettings load_accel_settings(const std::filesystem::path& path) {
+    if (path.extension() != ".toml") return {};
+    const Reader r(path.string());
+    return read_accel(r, parse_scene_file(r, path));
 }
 
 Scene load_scene(const std::filesystem::path& path, UpAxis mesh_up) {

@@ -6,6 +6,7 @@
 #include <string_view>
 
 #include "sim/core/error.hpp"
+#include "sim/scene/accel_settings.hpp"
 #include "sim/scene/bvh.hpp"
 #include "sim/scene/scene.hpp"
 
@@ -32,6 +33,10 @@ Scene load_scene(const std::filesystem::path& path, UpAxis mesh_up = UpAxis::pos
 
 Scene load_scene_file(const std::filesystem::path& toml_path);
 Scene scene_from_mesh(const std::filesystem::path& mesh_path, UpAxis up = UpAxis::pos_y);
+
+/// The [accel] table of a scene file: the structure it asks for and its settings (unset for a
+/// bare mesh, or a scene file without one). Throws SceneError as load_scene does.
+AccelSettings load_accel_settings(const std::filesystem::path& path);
 
 /// Bounds of all vertices; requires at least one triangle.
 Aabb bounds_of(std::span<const Triangle> triangles);

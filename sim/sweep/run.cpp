@@ -41,17 +41,7 @@ render::RenderOptions render_options(const JobRun& run) {
     options.kernel = run.kernel;
     options.engine = run.timing == "none" ? render::Engine::functional : render::Engine::timing;
     if (run.timing == "sampled") options.sampling = render::SamplingOptions{};
-    options.bvh.builder = *scene::find_bvh_builder(run.bvh);
-    options.bvh.max_leaf_size = run.max_leaf;
-    options.bvh.order = *scene::find_bvh_order(run.bvh_order);
-    options.bvh.align_pairs = run.bvh_align_pairs;
-    options.bvh.boxes = *scene::find_bvh_boxes(run.bvh_boxes);
-    if (!run.accel.empty()) options.accel = scene::find_accel(run.accel)->structure;
-    options.grid.resolution = run.grid_resolution;
-    options.grid.density = run.grid_density;
-    options.kdtree.max_depth = run.kdtree_max_depth;
-    options.kdtree.max_references_per_triangle = run.kdtree_max_references;
-    options.octree.max_depth = run.octree_max_depth;
+    options.accel = run.accel;
     options.image_width = run.width;
     options.image_height = run.height;
     options.samples_per_pixel = run.spp;

@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "sim/scene/accel_settings.hpp"
 #include "sim/timing/config.hpp"
 
 namespace tpsim::sweep {
@@ -23,18 +24,9 @@ using Json = nlohmann::ordered_json;
 struct JobRun {
     std::filesystem::path scene;
     std::filesystem::path kernel;
-    /// The acceleration structure asked for (scene::kAccelStructures' names); "": the kernel's.
-    std::string accel;
-    uint32_t grid_resolution = 0;       ///< scene::GridConfig::resolution
-    double grid_density = 4.0;          ///< scene::GridConfig::density
-    uint32_t kdtree_max_depth = 0;      ///< scene::KdTreeConfig::max_depth
-    double kdtree_max_references = 64;  ///< scene::KdTreeConfig::max_references_per_triangle
-    uint32_t octree_max_depth = 0;      ///< scene::OctreeConfig::max_depth
-    std::string bvh = "sweep";          ///< BVH builder: sweep, binned or median
-    uint32_t max_leaf = 8;
-    std::string bvh_order = "breadth-first";  ///< scene::BvhOrder, as to_string names it
-    bool bvh_align_pairs = false;             ///< scene::BvhConfig::align_pairs
-    std::string bvh_boxes = "float";          ///< scene::BvhBoxes, as to_string names it
+    /// The structure and its settings the sweep file gives (the key `accel` is the
+    /// structure); the rest come from the scene file's [accel] table and the defaults.
+    scene::AccelSettings accel;
     uint32_t width = 0, height = 0, spp = 0;  ///< 0: the scene's
     uint32_t seed = 0;
     std::string timing = "cycle";  ///< cycle, sampled or none (render --timing)

@@ -10,11 +10,8 @@
 #include "sim/core/error.hpp"
 #include "sim/core/input_file.hpp"
 #include "sim/core/toml_nesting.hpp"
-#include "sim/scene/accel.hpp"
-#include "sim/scene/bvh.hpp"
-#include "sim/scene/grid.hpp"
-#include "sim/scene/kdtree.hpp"
-#include "sim/scene/octree.hpp"
+#include "sim/scene/accel_settings.hpp"
+#include "sim/scene/load_scene.hpp"
 #include "sim/sweep/sweep.hpp"
 
 namespace tpsim::sweep {
@@ -23,13 +20,30 @@ namespace {
 constexpr std::uintmax_t kMaxSweepFileBytes = 1 << 20;
 /// More jobs than this is a mistake in the file, not a study (each job is one render).
 constexpr size_t kMaxJobs = 100000;
-constexpr int kPlanVersion = 3;
+constexpr int kPlanVersion = 4;
 
 /// A setting's value and the line it is written on.
 struct Value {
     Json value;
     int64_t line = 0;
 };
+
+/// A JSON value as the accel settings take it (an array or object: a string they refuse).
+scene::AccelValue accel_value(const Json& value) {
+    if (value.is_boolean()) return value.get<bool>();
+    if (value.is_number_integer()) return value.get<int64_t>();
+    if (value.is_number()) return value.get<double>();
+    if (value.is_string()) return value.get<std::string>();
+    return value.dump();
+}
+
+/// The settings a job sets, by name, for the plan.
+Json accel_json(const scene::AccelSettings& settings) {
+    Json object = Json::object();
+    for (const auto& [name, value] : scene::accel_setting_values(settings))
+        std::visit([&](const auto& v) { object[name] = v; }, value);
+    return object;
+}
 
 /// One key of the file before expansion: a fixed value, or an axis (an array).
 struct Entry {
@@ -253,30 +267,11 @@ private:
             } catch (const Error& e) {
                 fail(v.line, fmt::format("config: {}", e.what()));
             }
-        } else if (name == "accel") {
-            run.accel = one_of(name, v, scene::accel_names());
-        } else if (name == "grid_resolution") {
-            run.grid_resolution = uint32_t(integer(name, v, 0, scene::kGridMaxResolution));
-        } else if (name == "grid_density") {
-            run.grid_density = number(name, v, 1.0 / 1024, scene::kGridMaxDensity);
-        } else if (name == "kdtree_max_depth") {
-            run.kdtree_max_depth = uint32_t(integer(name, v, 0, scene::kKdMaxDepth));
-        } else if (name == "kdtree_max_references") {
-            run.kdtree_max_references = number(name, v, 1.0, 1e6);
-        } else if (name == "octree_max_depth") {
-            run.octree_max_depth = uint32_t(integer(name, v, 0, scene::kOctreeMaxDepth));
-        } else if (name == "bvh") {
-            run.bvh = one_of(name, v, scene::bvh_builder_names());
-        } else if (name == "bvh_order") {
-            run.bvh_order = one_of(name, v, scene::bvh_order_names());
-        } else if (name == "bvh_align_pairs") {
-            if (!v.value.is_boolean())
-                fail(v.line, fmt::format("{} must be true or false, got {}", name, v.value.dump()));
-            run.bvh_align_pairs = v.value.get<bool>();
-        } else if (name == "bvh_boxes") {
-            run.bvh_boxes = one_of(name, v, scene::bvh_boxes_names());
-        } else if (name == "max_leaf") {
-            run.max_leaf = uint32_t(integer(name, v, 1, 8));
+        } else if (name == "accel" || scene::is_accel_setting(name)) {
+            // The sweep's `accel` is the scene file's [accel] structure.
+            const std::string wrong = scene::set_accel_setting(
+                run.accel, name == "accel" ? "structure" : name, accel_value(v.value));
+            if (!wrong.empty()) fail(v.line, fmt::format("{} {}", name, wrong));
         } else if (name == "width") {
             run.width = uint32_t(integer(name, v, 1, 16384));
         } else if (name == "height") {
@@ -412,11 +407,17 @@ private:
             if (s.name == "config") apply(job.run, s.name, {s.value, line_of(s.name)});
         for (const Setting& s : settings)
             if (s.name != "config") apply(job.run, s.name, {s.value, line_of(s.name)}, &chip_keys);
-        // No kernel: the tracer of the structure asked for.
-        if (job.run.kernel.empty())
+        // No kernel: the tracer of the structure asked for, here or in the scene file.
+        if (job.run.kernel.empty()) {
+            std::optional<scene::AccelStructure> structure = job.run.accel.structure;
+            try {
+                if (!structure) structure = scene::load_accel_settings(job.run.scene).structure;
+            } catch (const Error& e) {
+                fail(line_of("scene"), e.what());
+            }
             job.run.kernel = resolve_kernel_(std::string(
-                job.run.accel.empty() ? "tracer"
-                                      : scene::find_accel(job.run.accel)->default_kernel));
+                scene::accel_info(structure.value_or(scene::AccelStructure::bvh2)).default_kernel));
+        }
         if (chip_keys.empty()) return;
         // All keys at once over the base, then validated together (l1.line_bytes and
         // l2.line_bytes may only change together). Each key is written on its line of the
@@ -504,17 +505,7 @@ void write_plan(const Sweep& sweep, const std::filesystem::path& dir) {
                         {"run",
                          {{"scene", r.scene.string()},
                           {"kernel", r.kernel.string()},
-                          {"accel", r.accel},
-                          {"grid_resolution", r.grid_resolution},
-                          {"grid_density", r.grid_density},
-                          {"kdtree_max_depth", r.kdtree_max_depth},
-                          {"kdtree_max_references", r.kdtree_max_references},
-                          {"octree_max_depth", r.octree_max_depth},
-                          {"bvh", r.bvh},
-                          {"max_leaf", r.max_leaf},
-                          {"bvh_order", r.bvh_order},
-                          {"bvh_align_pairs", r.bvh_align_pairs},
-                          {"bvh_boxes", r.bvh_boxes},
+                          {"accel", accel_json(r.accel)},
                           {"width", r.width},
                           {"height", r.height},
                           {"spp", r.spp},
@@ -577,17 +568,10 @@ Sweep read_plan(const std::filesystem::path& dir) {
             const Json& r = j.at("run");
             job.run.scene = r.at("scene").get<std::string>();
             job.run.kernel = r.at("kernel").get<std::string>();
-            job.run.accel = r.at("accel").get<std::string>();
-            job.run.grid_resolution = r.at("grid_resolution").get<uint32_t>();
-            job.run.grid_density = r.at("grid_density").get<double>();
-            job.run.kdtree_max_depth = r.at("kdtree_max_depth").get<uint32_t>();
-            job.run.kdtree_max_references = r.at("kdtree_max_references").get<double>();
-            job.run.octree_max_depth = r.at("octree_max_depth").get<uint32_t>();
-            job.run.bvh = r.at("bvh").get<std::string>();
-            job.run.max_leaf = r.at("max_leaf").get<uint32_t>();
-            job.run.bvh_order = r.at("bvh_order").get<std::string>();
-            job.run.bvh_align_pairs = r.at("bvh_align_pairs").get<bool>();
-            job.run.bvh_boxes = r.at("bvh_boxes").get<std::string>();
+            for (const auto& [name, value] : r.at("accel").items())
+                if (!scene::is_accel_setting(name) ||
+                    !scene::set_accel_setting(job.run.accel, name, accel_value(value)).empty())
+                    throw bad(fmt::format("job {} has a bad accel setting {}", job.id, name));
             job.run.width = r.at("width").get<uint32_t>();
             job.run.height = r.at("height").get<uint32_t>();
             job.run.spp = r.at("spp").get<uint32_t>();

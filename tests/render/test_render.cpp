@@ -1,5 +1,6 @@
 // End to end: the simulated machine and the native twin render bit-identical images.
 #include <cstring>
+#include <fstream>
 
 #include <catch2/catch.hpp>
 
@@ -138,6 +139,53 @@ TEST_CASE("render: the course experiments' variants render the tracer's image at
         if (name == "bvh_no_early_out.elf" || name == "closest_hit_shadows.elf")
             CHECK(variant.traversal.nodes_visited > tracer.traversal.nodes_visited);
     }
+}
+
+TEST_CASE("render: the grid walk without its early stop renders tracer_grid's image, reading "
+          "more cells",
+          "[render]") {
+    const auto run = [](const char* kernel) {
+        return render::render(small_options("cornell.toml", kernel, render::Engine::functional));
+    };
+    const render::RenderResult grid = run("tracer_grid.elf");
+    const render::RenderResult walk_on = run("grid_no_early_stop.elf");
+    CHECK(first_difference(grid.rgb, walk_on.rgb) == -1);
+    CHECK(walk_on.traversal.triangles_tested > grid.traversal.triangles_tested);
+    CHECK(walk_on.traversal.nodes_visited > grid.traversal.nodes_visited);
+}
+
+TEST_CASE("render: a scene file's [accel] table picks the structure and its settings; the "
+          "command's settings win",
+          "[render]") {
+    const std::filesystem::path dir = std::filesystem::path(TPSIM_BINARY_DIR) / "accel_table";
+    std::filesystem::create_directories(dir);
+    const std::filesystem::path scene = dir / "cornell_kd.toml";
+    {
+        std::ofstream out(scene);
+        out << "[accel]\nstructure = \"kdtree\"\nkdtree_max_depth = 3\n[[meshes]]\npath = \""
+            << (std::filesystem::path(TPSIM_SOURCE_DIR) / "scenes" / "cornell.obj").string()
+            << "\"\n";
+    }
+    render::RenderOptions o =
+        small_options("cornell.toml", "tracer_kdtree.elf", render::Engine::functional);
+    o.scene = scene;
+    const render::RenderResult from_scene = render::render(o);
+    CHECK(from_scene.accel == scene::AccelStructure::kdtree);
+    CHECK(from_scene.accel_configs.kdtree.max_depth == 3);
+    REQUIRE(from_scene.kdtree);
+    CHECK(from_scene.kdtree->depth_limit == 3);
+
+    o.accel.kdtree_max_depth = 5;
+    CHECK(render::render(o).kdtree->depth_limit == 5);
+
+    // A kernel for another structure is refused, naming the scene file's key and both ways out.
+    o.kernel = std::filesystem::path(TPSIM_KERNEL_DIR) / "tracer.elf";
+    CHECK_THROWS_WITH(render::render(o),
+                      Catch::Contains("[accel] structure = \"kdtree\" asks for the kd-tree") &&
+                          Catch::Contains("--kernel tracer_kdtree") &&
+                          Catch::Contains("--accel bvh2"));
+    o.accel.structure = scene::AccelStructure::bvh2;
+    CHECK(render::render(o).accel == scene::AccelStructure::bvh2);
 }
 
 namespace {

@@ -235,3 +235,57 @@ TEST_CASE("The shipped scenes load", "[scenefile][shipped]") {
         WARN("SKIPPED bunny.toml: install glmark2-data");
     }
 }
+
+TEST_CASE("A scene file's [accel] table is read; settings stack, the one above winning",
+          "[scenefile]") {
+    const auto path = scene_with("accel.toml", R"(
+[accel]
+structure = "bvh4"
+bvh_boxes = "quantized"
+grid_density = 2
+bvh_align_pairs = true
+[[meshes]]
+path = "tri.obj"
+)");
+    const AccelSettings file = load_accel_settings(path);
+    CHECK(file.structure == AccelStructure::bvh4);
+    CHECK(file.bvh_boxes == BvhBoxes::quantized);
+    CHECK(file.grid_density == 2.0);
+    CHECK(file.bvh_align_pairs == true);
+    CHECK_FALSE(file.max_leaf);
+    CHECK_NOTHROW(load_scene(path));  // the loader accepts the table it checks
+
+    AccelSettings command;
+    command.structure = AccelStructure::bvh8;
+    command.max_leaf = 2;
+    const AccelSettings merged = file.under(command);
+    CHECK(merged.structure == AccelStructure::bvh8);
+    CHECK(merged.max_leaf == 2u);
+    CHECK(merged.bvh_boxes == BvhBoxes::quantized);
+    const AccelConfigs configs = accel_configs(merged);
+    CHECK(configs.bvh.max_leaf_size == 2);
+    CHECK(configs.bvh.boxes == BvhBoxes::quantized);
+    CHECK(configs.grid.density == 2.0);
+    CHECK(configs.kdtree.max_depth == KdTreeConfig{}.max_depth);
+
+    // What is set, by name, sets the same again (a sweep plan stores settings so).
+    AccelSettings again;
+    for (const auto& [name, value] : accel_setting_values(merged))
+        CHECK(set_accel_setting(again, name, value).empty());
+    CHECK(again == merged);
+    CHECK(load_accel_settings(write_file("tri_only.obj", kTriangleObj)) == AccelSettings{});
+}
+
+TEST_CASE("A bad [accel] setting names its key, the file and the line", "[scenefile]") {
+    CHECK(error_of(scene_with("accel_depth.toml", "[accel]\noctree_max_depth = 99\n"
+                                                  "[[meshes]]\npath = \"tri.obj\"\n"))
+              .ends_with("accel_depth.toml:2:20: accel.octree_max_depth must be a whole number "
+                         "in [0, 16], got 99"));
+    CHECK(error_of(scene_with("accel_order.toml", "[accel]\nbvh_order = 3\n"
+                                                  "[[meshes]]\npath = \"tri.obj\"\n"))
+              .ends_with("accel_order.toml:2:13: accel.bvh_order must be one of breadth-first, "
+                         "depth-first, van-emde-boas, got 3"));
+    CHECK(error_of(scene_with("accel_flag.toml", "[accel]\nbvh_align_pairs = \"yes\"\n"
+                                                 "[[meshes]]\npath = \"tri.obj\"\n"))
+              .ends_with("accel.bvh_align_pairs must be true or false, got \"yes\""));
+}

@@ -74,7 +74,7 @@ size_bytes = [8192, 16384]
     // Each job's run is resolved from its settings.
     const JobRun& last = sweep.jobs[11].run;
     CHECK(last.scene == std::filesystem::absolute(dir / "scenes" / "b.toml").lexically_normal());
-    CHECK(last.bvh == "median");
+    CHECK(last.accel.bvh_builder == tpsim::scene::BvhBuilder::median);
     CHECK(last.width == 16);
     CHECK(last.chip.l1.size_bytes == 16384);
     CHECK(last.kernel == "/kernels/tracer.elf");  // the default kernel
@@ -205,6 +205,29 @@ TEST_CASE("sweep: bad sweep files are one line naming file:line", "[sweep]") {
               .jobs.size() == 2);
 }
 
+TEST_CASE("sweep: with no kernel, a job gets the tracer of the structure it or its scene file "
+          "names",
+          "[sweep]") {
+    const auto dir = fresh_scratch_dir("default_kernel");
+    std::filesystem::create_directories(dir / "scenes");
+    std::ofstream(dir / "scenes" / "grid.toml") << "[accel]\nstructure = \"grid\"\n";
+    std::ofstream(dir / "sweep.toml") << "scene = [\"scenes/grid.toml\", \"scenes/a.toml\"]\n";
+    std::ofstream(dir / "scenes" / "a.toml") << "# scene\n";
+    const Sweep by_scene = load_sweep(dir / "sweep.toml", fake_kernel);
+    CHECK(by_scene.jobs[0].run.kernel == "/kernels/tracer_grid.elf");
+    CHECK(by_scene.jobs[1].run.kernel == "/kernels/tracer.elf");
+    // The sweep's own accel wins over the scene file's.
+    std::ofstream(dir / "sweep.toml") << "scene = \"scenes/grid.toml\"\naccel = \"octree\"\n";
+    CHECK(load_sweep(dir / "sweep.toml", fake_kernel).jobs[0].run.kernel ==
+          "/kernels/tracer_octree.elf");
+    // A bad [accel] table is the scene file's error, on the sweep file's scene line.
+    std::ofstream(dir / "scenes" / "grid.toml") << "[accel]\nstructure = 4\n";
+    std::ofstream(dir / "sweep.toml") << "scene = \"scenes/grid.toml\"\n";
+    CHECK_THROWS_WITH(load_sweep(dir / "sweep.toml", fake_kernel),
+                      Catch::Contains("sweep.toml:1: ") &&
+                          Catch::Contains("grid.toml:2:13: accel.structure must be one of"));
+}
+
 TEST_CASE("sweep: the plan file holds every job's resolved run", "[sweep]") {
     const auto dir = fresh_scratch_dir("plan");
     const Sweep sweep = load_text(dir, R"(scene = ["scenes/a.toml", "scenes/b.toml"]
@@ -212,6 +235,9 @@ config = ")" + (kSource / "configs" / "tiny.toml").string() +
                                            R"("
 timing = "none"
 l2.size_bytes = [4096, 8192]
+bvh = "median"
+bvh_align_pairs = true
+grid_density = 0.5
 )");
     write_plan(sweep, dir / "results");
     const Sweep back = read_plan(dir / "results");
@@ -223,6 +249,9 @@ l2.size_bytes = [4096, 8192]
         CHECK(back.jobs[j].run.timing == "none");
         CHECK(back.jobs[j].run.chip == sweep.jobs[j].run.chip);
         CHECK(back.jobs[j].run.chip.chip.num_tms == 1);  // from the base configuration
+        CHECK(back.jobs[j].run.accel == sweep.jobs[j].run.accel);
+        CHECK(back.jobs[j].run.accel.grid_density == 0.5);
+        CHECK_FALSE(back.jobs[j].run.accel.structure);  // unset stays unset: the scene's decides
     }
     CHECK(back.jobs[1].run.chip.l2.size_bytes == 8192);
     CHECK(back.describe(back.jobs[3]) == sweep.describe(sweep.jobs[3]));
@@ -230,7 +259,7 @@ l2.size_bytes = [4096, 8192]
     CHECK_THROWS_WITH(read_plan(dir), Catch::Contains("is not a sweep's results directory"));
     std::ofstream(plan_path(dir / "results")) << "{\"format\": \"tpsim-sweep\", \"version\": 7}";
     CHECK_THROWS_WITH(read_plan(dir / "results"),
-                      Catch::Contains("written by plan version 7; this tpsim reads version 3"));
+                      Catch::Contains("written by plan version 7; this tpsim reads version 4"));
 }
 
 TEST_CASE("sweep: finished, pending and failed jobs; collect reads the statistics files",

@@ -126,8 +126,8 @@ TEST_CASE("BVH node orders move the traffic, never the image or the instructions
             options.kernel = TPSIM_KERNEL_DIR "/tracer.elf";
             options.engine = render::Engine::timing;
             options.chip = tiny();
-            options.bvh.order = order;
-            options.bvh.align_pairs = align;
+            options.accel.bvh_order = order;
+            options.accel.bvh_align_pairs = align;
             const auto result = render::render(options);
             INFO(scene::to_string(order) << (align ? ", aligned" : ""));
             CHECK(same_bits(result.rgb, reference.rgb));
@@ -192,8 +192,8 @@ TEST_CASE("The wide BVHs render the binary BVH's image in both box formats, the 
         for (scene::BvhBoxes boxes : scene::kBvhBoxes) {
             INFO(scene::to_string(structure) << " " << scene::to_string(boxes));
             render::RenderOptions options = structure_run("tracer_wide.elf");
-            options.accel = structure;
-            options.bvh.boxes = boxes;
+            options.accel.structure = structure;
+            options.accel.bvh_boxes = boxes;
             const auto result = render_on_one_and_two_host_threads(options, reference);
             REQUIRE(result.wide_bvh);
             CHECK(result.wide_bvh->width == scene::wide_bvh_width(structure));
