@@ -119,6 +119,13 @@ int main(int argc, char** argv) {
                 [&] { return build_kdtree(scene.triangles); },
                 [](const KdTreeStats& k) { return fmt::format("kdtree depth {}", k.max_depth); });
             cells_row(
+                [&] {
+                    KdTreeConfig bsp;
+                    bsp.general_planes = true;
+                    return build_kdtree(scene.triangles, bsp);
+                },
+                [](const KdTreeStats& k) { return fmt::format("bsp depth {}", k.max_depth); });
+            cells_row(
                 [&] { return build_octree(scene.triangles); },
                 [](const OctreeStats& o) { return fmt::format("octree depth {}", o.max_depth); });
         }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -50,45 +51,79 @@ std::pair<double, double> project(uint32_t direction, const Aabb& box) {
     return {lo, hi};
 }
 
-/// The box of the part of `box` below (n.x <= split) or above the plane: exact for an axis; for
-/// a diagonal, the box of the clipped corners and edge crossings, rounded outwards.
-Aabb half_box(const Aabb& box, uint32_t direction, float split, bool above) {
-    Aabb out = box;
-    if (direction < 3) {
-        (above ? out.lo : out.hi)[int(direction)] = split;
-        return out;
-    }
-    glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-lo);
-    const auto keep = [&](const glm::dvec3& p) {
-        lo = glm::min(lo, p);
-        hi = glm::max(hi, p);
-    };
-    const auto side = [&](const glm::dvec3& p) {
-        const double s = project(direction, p) - double(split);
-        return above ? s >= 0 : s <= 0;
-    };
-    const auto corner = [&](int c) {
-        return glm::dvec3(c & 1 ? box.hi.x : box.lo.x, c & 2 ? box.hi.y : box.lo.y,
-                          c & 4 ? box.hi.z : box.lo.z);
-    };
-    for (int c = 0; c < 8; ++c) {
-        const glm::dvec3 p = corner(c);
-        if (side(p)) keep(p);
-        for (int a = 0; a < 3; ++a) {  // the edge from corner c along axis a, once
-            if (c >> a & 1) continue;
-            const glm::dvec3 q = corner(c | 1 << a);
-            const double sp = project(direction, p) - double(split);
-            const double sq = project(direction, q) - double(split);
-            if ((sp < 0) != (sq < 0)) keep(p + (q - p) * (sp / (sp - sq)));
+/// The next float below (above) x, as std::nextafter(x, -inf) (+inf) gives it for a finite x,
+/// without the library call: the builder rounds millions of clipped boxes outwards.
+float next_down(float x) {
+    if (x == 0) return -std::numeric_limits<float>::denorm_min();
+    const auto bits = std::bit_cast<uint32_t>(x);
+    return std::bit_cast<float>(x > 0 ? bits - 1 : bits + 1);
+}
+float next_up(float x) {
+    return -next_down(-x);
+}
+
+/// A box cut by planes n.x = split of one orientation, for every split the builder tries on it:
+/// the corners and their n.x are worked out once. Each half is exact for an axis; for a
+/// diagonal, it is the box of the corners on its side and the edge crossings, rounded outwards.
+class BoxCut {
+public:
+    BoxCut(const Aabb& box, uint32_t direction) : box_(box), direction_(direction) {
+        if (direction < 3) return;
+        for (int c = 0; c < 8; ++c) {
+            corner_[size_t(c)] = glm::dvec3(c & 1 ? box.hi.x : box.lo.x, c & 2 ? box.hi.y : box.lo.y,
+                                            c & 4 ? box.hi.z : box.lo.z);
+            n_dot_[size_t(c)] = project(direction, corner_[size_t(c)]);
         }
     }
-    if (!(lo.x <= hi.x)) return box;  // nothing on that side (not chosen by the heuristic)
-    for (int a = 0; a < 3; ++a) {
-        out.lo[a] = std::max(box.lo[a], std::nextafter(float(lo[a]), -INFINITY));
-        out.hi[a] = std::min(box.hi[a], std::nextafter(float(hi[a]), INFINITY));
+
+    /// The part below the plane (n.x <= split) and the part above.
+    std::pair<Aabb, Aabb> halves(float split) const {
+        Aabb below = box_, above = box_;
+        if (direction_ < 3) {
+            below.hi[int(direction_)] = split;
+            above.lo[int(direction_)] = split;
+            return {below, above};
+        }
+        const glm::dvec3 none(std::numeric_limits<double>::infinity());
+        glm::dvec3 below_lo = none, below_hi = -none, above_lo = none, above_hi = -none;
+        const auto keep = [](glm::dvec3& lo, glm::dvec3& hi, const glm::dvec3& p) {
+            lo = glm::min(lo, p);
+            hi = glm::max(hi, p);
+        };
+        for (size_t c = 0; c < 8; ++c) {
+            const glm::dvec3& p = corner_[c];
+            const double sp = n_dot_[c] - double(split);
+            if (sp <= 0) keep(below_lo, below_hi, p);
+            if (sp >= 0) keep(above_lo, above_hi, p);
+            for (size_t a = 0; a < 3; ++a) {  // the edge from corner c along axis a, once
+                if (c >> a & 1) continue;
+                const size_t q = c | size_t(1) << a;
+                const double sq = n_dot_[q] - double(split);
+                if ((sp < 0) == (sq < 0)) continue;
+                const glm::dvec3 crossing = p + (corner_[q] - p) * (sp / (sp - sq));
+                keep(below_lo, below_hi, crossing);
+                keep(above_lo, above_hi, crossing);
+            }
+        }
+        return {rounded_out(below_lo, below_hi), rounded_out(above_lo, above_hi)};
     }
-    return out;
-}
+
+private:
+    Aabb rounded_out(const glm::dvec3& lo, const glm::dvec3& hi) const {
+        if (!(lo.x <= hi.x)) return box_;  // nothing on that side (not chosen by the heuristic)
+        Aabb out;
+        for (int a = 0; a < 3; ++a) {
+            out.lo[a] = std::max(box_.lo[a], next_down(float(lo[a])));
+            out.hi[a] = std::min(box_.hi[a], next_up(float(hi[a])));
+        }
+        return out;
+    }
+
+    Aabb box_;
+    uint32_t direction_;
+    std::array<glm::dvec3, 8> corner_{};
+    std::array<double, 8> n_dot_{};
+};
 
 /// A node as the build makes it, before the tree is laid out depth-first (once, at the end).
 struct BuildNode {
@@ -121,6 +156,7 @@ public:
         auto out = std::make_unique<BuildNode>();
         const auto [axis, split] = choose_split(box, refs, depth);
         std::vector<uint32_t> left, right;
+        const BoxCut cut(box, uint32_t(std::max(axis, 0)));
         if (axis >= 0) {
             const auto k = uint32_t(axis);
             const glm::vec3 extent = box.hi - box.lo;
@@ -140,7 +176,7 @@ public:
         // The margin puts triangles on or near the plane on both sides, which the binned cost
         // did not count: a split that then costs more than the leaf (or moves nothing) is none.
         if (axis < 0 || (bad && bad_cuts == kMaxBadCuts) ||
-            split_cost(box, axis, split, left.size(), right.size()) >=
+            split_cost(box, cut, axis, split, left.size(), right.size()) >=
                 kIntersectionCost * double(refs.size())) {
             // Refused as soon as the leaves hold too many, before they fill the memory.
             const uint64_t total = references_ += refs.size();
@@ -154,8 +190,7 @@ public:
             return out;
         }
         refs = {};
-        const Aabb left_box = half_box(box, uint32_t(axis), split, false);
-        const Aabb right_box = half_box(box, uint32_t(axis), split, true);
+        const auto [left_box, right_box] = cut.halves(split);
         out->axis = axis;
         out->split = split;
         if (left.size() + right.size() > kParallelReferences)
@@ -185,6 +220,7 @@ private:
             const auto [lo, hi] = project(k, box);
             const double extent = hi - lo;
             if (!(extent > 0) || box_area <= 0) continue;
+            const BoxCut cut(box, k);
             std::array<uint32_t, kBins> starts{}, ends{};
             const auto bin = [&](float x) {
                 return int(std::clamp(std::floor((double(x) - lo) / extent * kBins), 0.0,
@@ -207,8 +243,8 @@ private:
                 left_count += starts[size_t(b - 1)];
                 const float split = float(lo + extent * b / kBins);
                 if (!(split > lo && split < hi)) continue;
-                const double cost =
-                    split_cost(box, axis, split, left_count, right_count[size_t(b)]);
+                const double cost = split_cost(box, cut, axis, split, left_count,
+                                               right_count[size_t(b)]);
                 if (cost < best_cost) {
                     best_cost = cost;
                     best = {axis, split};
@@ -219,12 +255,12 @@ private:
     }
 
     /// The SAH cost of splitting `box` at `split` with nl and nr triangles on the two sides.
-    static double split_cost(const Aabb& box, int axis, float split, size_t nl, size_t nr) {
+    static double split_cost(const Aabb& box, const BoxCut& cut, int axis, float split, size_t nl,
+                             size_t nr) {
         // A diagonal plane that cuts off an empty corner leaves the other side's box as it was:
         // by boxes it would look free, and a chain of them would fill the depth with nothing.
         if (axis >= 3 && (nl == 0 || nr == 0)) return std::numeric_limits<double>::infinity();
-        const Aabb left = half_box(box, uint32_t(axis), split, false);
-        const Aabb right = half_box(box, uint32_t(axis), split, true);
+        const auto [left, right] = cut.halves(split);
         const double cost = kTraversalCost + kIntersectionCost *
                                                  (area(left.lo, left.hi) * double(nl) +
                                                   area(right.lo, right.hi) * double(nr)) /
