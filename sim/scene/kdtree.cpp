@@ -70,8 +70,9 @@ public:
     BoxCut(const Aabb& box, uint32_t direction) : box_(box), direction_(direction) {
         if (direction < 3) return;
         for (int c = 0; c < 8; ++c) {
-            corner_[size_t(c)] = glm::dvec3(c & 1 ? box.hi.x : box.lo.x, c & 2 ? box.hi.y : box.lo.y,
-                                            c & 4 ? box.hi.z : box.lo.z);
+            corner_[size_t(c)] =
+                glm::dvec3(c & 1 ? box.hi.x : box.lo.x, c & 2 ? box.hi.y : box.lo.y,
+                           c & 4 ? box.hi.z : box.lo.z);
             n_dot_[size_t(c)] = project(direction, corner_[size_t(c)]);
         }
     }
@@ -243,8 +244,8 @@ private:
                 left_count += starts[size_t(b - 1)];
                 const float split = float(lo + extent * b / kBins);
                 if (!(split > lo && split < hi)) continue;
-                const double cost = split_cost(box, cut, axis, split, left_count,
-                                               right_count[size_t(b)]);
+                const double cost =
+                    split_cost(box, cut, axis, split, left_count, right_count[size_t(b)]);
                 if (cost < best_cost) {
                     best_cost = cost;
                     best = {axis, split};
