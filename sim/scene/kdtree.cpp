@@ -28,9 +28,13 @@ constexpr uint32_t kMaxBadCuts = 2;
 /// Subtrees with fewer references than this are built on the calling thread.
 constexpr size_t kParallelReferences = 4096;
 
-double area(const glm::vec3& lo, const glm::vec3& hi) {
-    const glm::dvec3 d = glm::max(glm::dvec3(hi) - glm::dvec3(lo), glm::dvec3(0));
+/// The surface area of a box of extent d.
+double surface(const glm::dvec3& d) {
     return 2 * (d.x * d.y + d.y * d.z + d.z * d.x);
+}
+
+double area(const glm::vec3& lo, const glm::vec3& hi) {
+    return surface(glm::max(glm::dvec3(hi) - glm::dvec3(lo), glm::dvec3(0)));
 }
 
 /// n.p for the plane orientation n = kBspDirection[direction], in double (exact for the axes).
@@ -67,7 +71,10 @@ float next_up(float x) {
 /// diagonal, it is the box of the corners on its side and the edge crossings, rounded outwards.
 class BoxCut {
 public:
-    BoxCut(const Aabb& box, uint32_t direction) : box_(box), direction_(direction) {
+    BoxCut(const Aabb& box, uint32_t direction)
+        : box_(box), direction_(direction),
+          extent_(glm::max(glm::dvec3(box.hi) - glm::dvec3(box.lo), glm::dvec3(0))),
+          area_(surface(extent_)) {
         if (direction < 3) return;
         for (int c = 0; c < 8; ++c) {
             corner_[size_t(c)] =
@@ -109,6 +116,22 @@ public:
         return {rounded_out(below_lo, below_hi), rounded_out(above_lo, above_hi)};
     }
 
+    /// The surface areas of the two halves, as area() of halves() gives them; for an axis,
+    /// without making the boxes (the kd-tree prices millions of planes).
+    std::pair<double, double> half_areas(float split) const {
+        if (direction_ >= 3) {
+            const auto [below, above] = halves(split);
+            return {area(below.lo, below.hi), area(above.lo, above.hi)};
+        }
+        const int a = int(direction_);
+        glm::dvec3 below = extent_, above = extent_;
+        below[a] = std::max(double(split) - double(box_.lo[a]), 0.0);
+        above[a] = std::max(double(box_.hi[a]) - double(split), 0.0);
+        return {surface(below), surface(above)};
+    }
+
+    double box_area() const { return area_; }
+
 private:
     Aabb rounded_out(const glm::dvec3& lo, const glm::dvec3& hi) const {
         if (!(lo.x <= hi.x)) return box_;  // nothing on that side (not chosen by the heuristic)
@@ -122,6 +145,8 @@ private:
 
     Aabb box_;
     uint32_t direction_;
+    glm::dvec3 extent_;
+    double area_;
     std::array<glm::dvec3, 8> corner_{};
     std::array<double, 8> n_dot_{};
 };
@@ -177,7 +202,7 @@ public:
         // The margin puts triangles on or near the plane on both sides, which the binned cost
         // did not count: a split that then costs more than the leaf (or moves nothing) is none.
         if (axis < 0 || (bad && bad_cuts == kMaxBadCuts) ||
-            split_cost(box, cut, axis, split, left.size(), right.size()) >=
+            split_cost(cut, axis, split, left.size(), right.size()) >=
                 kIntersectionCost * double(refs.size())) {
             // Refused as soon as the leaves hold too many, before they fill the memory.
             const uint64_t total = references_ += refs.size();
@@ -245,7 +270,7 @@ private:
                 const float split = float(lo + extent * b / kBins);
                 if (!(split > lo && split < hi)) continue;
                 const double cost =
-                    split_cost(box, cut, axis, split, left_count, right_count[size_t(b)]);
+                    split_cost(cut, axis, split, left_count, right_count[size_t(b)]);
                 if (cost < best_cost) {
                     best_cost = cost;
                     best = {axis, split};
@@ -256,16 +281,14 @@ private:
     }
 
     /// The SAH cost of splitting `box` at `split` with nl and nr triangles on the two sides.
-    static double split_cost(const Aabb& box, const BoxCut& cut, int axis, float split, size_t nl,
-                             size_t nr) {
+    static double split_cost(const BoxCut& cut, int axis, float split, size_t nl, size_t nr) {
         // A diagonal plane that cuts off an empty corner leaves the other side's box as it was:
         // by boxes it would look free, and a chain of them would fill the depth with nothing.
         if (axis >= 3 && (nl == 0 || nr == 0)) return std::numeric_limits<double>::infinity();
-        const auto [left, right] = cut.halves(split);
+        const auto [left, right] = cut.half_areas(split);
         const double cost = kTraversalCost + kIntersectionCost *
-                                                 (area(left.lo, left.hi) * double(nl) +
-                                                  area(right.lo, right.hi) * double(nr)) /
-                                                 area(box.lo, box.hi);
+                                                 (left * double(nl) + right * double(nr)) /
+                                                 cut.box_area();
         return nl == 0 || nr == 0 ? cost * kEmptyBonus : cost;
     }
 
