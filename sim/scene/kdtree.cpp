@@ -27,6 +27,10 @@ constexpr double kTraversalCost = 15, kIntersectionCost = 20, kEmptyBonus = 0.8;
 constexpr uint32_t kMaxBadCuts = 2;
 /// Subtrees with fewer references than this are built on the calling thread.
 constexpr size_t kParallelReferences = 4096;
+/// A BSP node prices every kPricedEvery-th diagonal plane first and bounds the others from them
+/// (Builder::choose_split); the bound is lowered by kBoundSlack for the rounding of the boxes.
+constexpr int kPricedEvery = 8;
+constexpr double kBoundSlack = 1 - 1e-5;
 
 /// The surface area of a box of extent d.
 double surface(const glm::dvec3& d) {
@@ -264,13 +268,41 @@ private:
                 sum += ends[size_t(b)];
                 right_count[size_t(b)] = sum;
             }
+            const auto split_at = [&](int b) { return float(lo + extent * b / kBins); };
+            // A diagonal plane's price clips the box, so most are bounded first: the half below
+            // only grows with the split and the half above only shrinks, so the areas at the
+            // priced planes around b bound b's from below (a little less, for the rounding).
+            // A plane whose bound is not below the best so far cannot become the best: the
+            // choice is the one pricing every plane gives.
+            std::array<std::pair<double, double>, kBins> priced{};  // (0, 0): no bound
+            if (k >= 3)
+                for (int b = 1; b < kBins + kPricedEvery - 1; b += kPricedEvery) {
+                    const int p = std::min(b, kBins - 1);  // ... and the last plane
+                    const float split = split_at(p);
+                    if (split > lo && split < hi) priced[size_t(p)] = cut.half_areas(split);
+                }
             uint32_t left_count = 0;
             for (int b = 1; b < kBins; ++b) {
                 left_count += starts[size_t(b - 1)];
-                const float split = float(lo + extent * b / kBins);
+                const float split = split_at(b);
                 if (!(split > lo && split < hi)) continue;
-                const double cost =
-                    split_cost(cut, axis, split, left_count, right_count[size_t(b)]);
+                const uint32_t nl = left_count, nr = right_count[size_t(b)];
+                if (k >= 3 && (nl == 0 || nr == 0)) continue;  // split_cost: infinite
+                double cost;
+                if (k >= 3 && (b - 1) % kPricedEvery == 0) {
+                    cost = sah_cost(priced[size_t(b)].first, priced[size_t(b)].second, box_area, nl,
+                                    nr);
+                } else if (k >= 3) {
+                    const int below = b - (b - 1) % kPricedEvery;
+                    const int above = std::min(below + kPricedEvery, kBins - 1);
+                    const double bound =
+                        sah_cost(priced[size_t(below)].first * kBoundSlack,
+                                 priced[size_t(above)].second * kBoundSlack, box_area, nl, nr);
+                    if (bound >= best_cost) continue;
+                    cost = split_cost(cut, axis, split, nl, nr);
+                } else {
+                    cost = split_cost(cut, axis, split, nl, nr);
+                }
                 if (cost < best_cost) {
                     best_cost = cost;
                     best = {axis, split};
@@ -286,9 +318,14 @@ private:
         // by boxes it would look free, and a chain of them would fill the depth with nothing.
         if (axis >= 3 && (nl == 0 || nr == 0)) return std::numeric_limits<double>::infinity();
         const auto [left, right] = cut.half_areas(split);
-        const double cost = kTraversalCost + kIntersectionCost *
-                                                 (left * double(nl) + right * double(nr)) /
-                                                 cut.box_area();
+        return sah_cost(left, right, cut.box_area(), nl, nr);
+    }
+
+    static double sah_cost(double left_area, double right_area, double box_area, size_t nl,
+                           size_t nr) {
+        const double cost =
+            kTraversalCost +
+            kIntersectionCost * (left_area * double(nl) + right_area * double(nr)) / box_area;
         return nl == 0 || nr == 0 ? cost * kEmptyBonus : cost;
     }
 
