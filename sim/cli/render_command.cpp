@@ -73,12 +73,16 @@ int run_render(RenderCommandOptions& o) {
         fmt::print(stderr, "tpsim: warning: {}\n", warning);
     };
     options.accel = o.accel;
-    // No kernel: the tracer of the structure --accel or the scene file's [accel] table names.
-    const scene::AccelStructure structure =
-        scene::load_accel_settings(o.scene).under(o.accel).structure.value_or(
-            scene::AccelStructure::bvh2);
-    options.kernel = resolve_kernel(
-        !o.kernel.empty() ? o.kernel : std::string(scene::accel_info(structure).default_kernel));
+    // No kernel: the tracer of the structure --accel or else the scene file's [accel] table
+    // names (the file is read for it only then).
+    if (o.kernel.empty()) {
+        const scene::AccelStructure structure =
+            o.accel.structure ? *o.accel.structure
+                              : scene::load_accel_settings(o.scene).structure.value_or(
+                                    scene::AccelStructure::bvh2);
+        o.kernel = scene::accel_info(structure).default_kernel;
+    }
+    options.kernel = resolve_kernel(o.kernel);
     options.params = o.params;
     options.engine = o.native             ? render::Engine::native
                      : o.timing != "none" ? render::Engine::timing

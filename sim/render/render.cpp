@@ -176,8 +176,7 @@ RenderResult render(const RenderOptions& options) {
         !warning.empty() && options.on_warning)
         options.on_warning(warning);
     // The command's settings over the scene file's [accel] table over the kernel's structure.
-    const scene::AccelSettings settings =
-        scene::load_accel_settings(options.scene).under(options.accel);
+    const scene::AccelSettings settings = result.scene.accel.under(options.accel);
     result.accel_configs = scene::accel_configs(settings);
     const scene::AccelConfigs& configs = result.accel_configs;
     result.accel = kernel.accel();

@@ -5,6 +5,7 @@
 // build) and pick its default kernel.
 #pragma once
 #include <array>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -80,6 +81,31 @@ constexpr std::optional<AccelInfo> find_accel(std::string_view name) {
         if (info.name == name) return info;
     return std::nullopt;
 }
+
+enum class BvhBuilder;  // sim/scene/bvh.hpp
+enum class BvhOrder;
+enum class BvhBoxes;
+
+/// Which structure to build and how, as one of the places that choose gives it (a scene file's
+/// [accel] table, a sweep's keys, render's options), unset where it does not choose; the keys,
+/// their checks and how the levels stack are in sim/scene/accel_settings.hpp.
+struct AccelSettings {
+    std::optional<AccelStructure> structure;      ///< key `structure` (the sweep's `accel`)
+    std::optional<BvhBuilder> bvh_builder;        ///< `bvh`
+    std::optional<uint32_t> max_leaf;             ///< `max_leaf`, 1..8
+    std::optional<BvhOrder> bvh_order;            ///< `bvh_order`
+    std::optional<bool> bvh_align_pairs;          ///< `bvh_align_pairs`
+    std::optional<BvhBoxes> bvh_boxes;            ///< `bvh_boxes`
+    std::optional<uint32_t> grid_resolution;      ///< `grid_resolution`
+    std::optional<double> grid_density;           ///< `grid_density`
+    std::optional<uint32_t> kdtree_max_depth;     ///< `kdtree_max_depth` (kd-tree and BSP)
+    std::optional<double> kdtree_max_references;  ///< `kdtree_max_references`
+    std::optional<uint32_t> octree_max_depth;     ///< `octree_max_depth`
+
+    /// These settings with each one that `above` sets in its place.
+    AccelSettings under(const AccelSettings& above) const;
+    bool operator==(const AccelSettings&) const = default;
+};
 
 /// The structure `name` names, or nullopt.
 constexpr std::optional<AccelStructure> find_accel_structure(std::string_view name) {

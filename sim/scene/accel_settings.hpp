@@ -20,24 +20,6 @@
 
 namespace tpsim::scene {
 
-struct AccelSettings {
-    std::optional<AccelStructure> structure;      ///< key `structure` (the sweep's `accel`)
-    std::optional<BvhBuilder> bvh_builder;        ///< `bvh`
-    std::optional<uint32_t> max_leaf;             ///< `max_leaf`, 1..8
-    std::optional<BvhOrder> bvh_order;            ///< `bvh_order`
-    std::optional<bool> bvh_align_pairs;          ///< `bvh_align_pairs`
-    std::optional<BvhBoxes> bvh_boxes;            ///< `bvh_boxes`
-    std::optional<uint32_t> grid_resolution;      ///< `grid_resolution`
-    std::optional<double> grid_density;           ///< `grid_density`
-    std::optional<uint32_t> kdtree_max_depth;     ///< `kdtree_max_depth` (kd-tree and BSP)
-    std::optional<double> kdtree_max_references;  ///< `kdtree_max_references`
-    std::optional<uint32_t> octree_max_depth;     ///< `octree_max_depth`
-
-    /// These settings with each one that `above` sets in its place.
-    AccelSettings under(const AccelSettings& above) const;
-    bool operator==(const AccelSettings&) const = default;
-};
-
 /// The builders' configurations: their defaults with the settings given applied.
 struct AccelConfigs {
     BvhConfig bvh;

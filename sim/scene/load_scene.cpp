@@ -835,8 +835,8 @@ Scene load_scene_file(const std::filesystem::path& toml_path) {
     r.allow_keys(root, "",
                  {"name", "image", "shading", "camera", "ambient", "background", "lights",
                   "materials", "meshes", "generators", "accel"});
-    read_accel(r, root);  // checked here too, so that every scene-file mistake is found on load
     Scene scene;
+    scene.accel = read_accel(r, root);
     scene.name = root.get("name") ? r.text(*root.get("name"), "name") : toml_path.stem().string();
     if (const toml::node* node = root.get("image")) {
         const toml::table& image = r.table(*node, "image");

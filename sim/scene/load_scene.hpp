@@ -34,8 +34,9 @@ Scene load_scene(const std::filesystem::path& path, UpAxis mesh_up = UpAxis::pos
 Scene load_scene_file(const std::filesystem::path& toml_path);
 Scene scene_from_mesh(const std::filesystem::path& mesh_path, UpAxis up = UpAxis::pos_y);
 
-/// The [accel] table of a scene file: the structure it asks for and its settings (unset for a
-/// bare mesh, or a scene file without one). Throws SceneError as load_scene does.
+/// The [accel] table of a scene file, without loading its geometry (Scene::accel holds it
+/// once loaded): for choosing the kernel before the scene is loaded. Unset for a bare mesh, or
+/// a scene file without one. Throws SceneError as load_scene does.
 AccelSettings load_accel_settings(const std::filesystem::path& path);
 
 /// Bounds of all vertices; requires at least one triangle.

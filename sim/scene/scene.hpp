@@ -7,6 +7,8 @@
 
 #include <glm/glm.hpp>
 
+#include "sim/scene/accel.hpp"
+
 namespace tpsim::scene {
 
 struct Triangle {
@@ -67,6 +69,7 @@ struct Scene {
     std::vector<SourceSummary> sources;  ///< in the order they were loaded
     Frame frame;  ///< triangles, camera and lights are in this frame's coordinates
     std::vector<std::string> warnings;  ///< for the user, one line each (without "tpsim: ")
+    AccelSettings accel;                ///< the scene file's [accel] table (unset for a bare mesh)
 };
 
 }  // namespace tpsim::scene

@@ -209,13 +209,6 @@ private:
         return v.value.get<uint64_t>();
     }
 
-    double number(const std::string& name, const Value& v, double lo, double hi) const {
-        if (!v.value.is_number() || !(v.value.get<double>() >= lo && v.value.get<double>() <= hi))
-            fail(v.line, fmt::format("{} must be a number in [{}, {}], got {}", name, lo, hi,
-                                     v.value.dump()));
-        return v.value.get<double>();
-    }
-
     std::string one_of(const std::string& name, const Value& v,
                        const std::vector<std::string>& allowed) const {
         if (v.value.is_string())
