@@ -8,9 +8,11 @@
 #include <limits>
 #include <memory>
 #include <stdexcept>
+#include <tuple>
 
 #include <fmt/format.h>
 #include <oneapi/tbb/parallel_invoke.h>
+#include <oneapi/tbb/scalable_allocator.h>
 
 #include "sim/scene/cells.hpp"
 
@@ -155,12 +157,26 @@ private:
     std::array<double, 8> n_dot_{};
 };
 
-/// A node as the build makes it, before the tree is laid out depth-first (once, at the end).
-struct BuildNode {
-    int axis = -1;  ///< -1: a leaf
+/// Triangle indices. Each level of the build makes new lists for both sides of its planes and
+/// frees the parent's: oneTBB's allocator keeps the freed memory for the next lists, where
+/// malloc would return large ones to the kernel and fault in zeroed pages again.
+using References = std::vector<uint32_t, tbb::scalable_allocator<uint32_t>>;
+
+/// Part of the tree laid out depth-first, as the kernel walks it, with node and reference
+/// indices of its own from 0.
+struct Subtree {
+    std::vector<KdNode> nodes;
+    References references;
+};
+
+/// The top of the tree, whose halves are built in parallel. A node of at most
+/// kParallelReferences references has its whole subtree built on one thread straight into its
+/// layout: the millions of nodes below are never allocated one by one.
+struct TopNode {
+    int axis = -1;  ///< -1: `subtree` holds the node's subtree
     float split = 0;
-    std::unique_ptr<BuildNode> below, above;
-    std::vector<uint32_t> references;  ///< leaf only
+    std::unique_ptr<TopNode> below, above;
+    Subtree subtree;
 };
 
 class Builder {
@@ -170,130 +186,239 @@ public:
         : name_(name), depth_limit_(depth_limit),
           max_references_(uint64_t(max_per_triangle * double(triangles.size()))),
           max_per_triangle_(max_per_triangle), directions_(directions),
-          lo_(triangles.size() * directions), hi_(triangles.size() * directions) {
+          ranges_(triangles.size() * directions) {
         for (size_t i = 0; i < triangles.size(); ++i) {
             const Triangle& t = triangles[i];
             for (uint32_t k = 0; k < directions; ++k) {
                 const double a = project(k, t.v0), b = project(k, t.v1), c = project(k, t.v2);
-                lo_[i * directions + k] = std::min({a, b, c});
-                hi_[i * directions + k] = std::max({a, b, c});
+                ranges_[i * directions + k] = {std::min({a, b, c}), std::max({a, b, c})};
             }
         }
     }
 
-    std::unique_ptr<BuildNode> build(const Aabb& box, std::vector<uint32_t> refs, uint32_t depth,
-                                     uint32_t bad_cuts) const {
-        auto out = std::make_unique<BuildNode>();
-        const auto [axis, split] = choose_split(box, refs, depth);
-        std::vector<uint32_t> left, right;
-        const BoxCut cut(box, uint32_t(std::max(axis, 0)));
+    std::unique_ptr<TopNode> build(const Aabb& box, References refs, uint32_t depth,
+                                   uint32_t bad_cuts) const {
+        auto out = std::make_unique<TopNode>();
+        if (refs.size() <= kParallelReferences) {
+            build(box, std::move(refs), depth, bad_cuts, out->subtree);
+            check_references(references_ += out->subtree.references.size());
+            return out;
+        }
+        Cut cut = choose_cut(box, refs, depth, bad_cuts);
+        if (cut.axis < 0) {
+            check_references(references_ += refs.size());
+            out->subtree.nodes.push_back({.first = 0, .count = uint32_t(refs.size())});
+            out->subtree.references = std::move(refs);
+            return out;
+        }
+        out->axis = cut.axis;
+        out->split = cut.split;
+        const uint32_t below_cuts = bad_cuts + cut.bad;
+        tbb::parallel_invoke(
+            [&] { out->below = build(cut.below_box, std::move(cut.below), depth + 1, below_cuts); },
+            [&] {
+                out->above = build(cut.above_box, std::move(cut.above), depth + 1, below_cuts);
+            });
+        return out;
+    }
+
+private:
+    /// Refuses the build as soon as the leaves hold too many references, before they fill the
+    /// memory.
+    void check_references(uint64_t total) const {
+        if (total > max_references_)
+            throw std::invalid_argument(fmt::format(
+                "{}: more than {} leaf references, {:g} per triangle, the limit: the scene's "
+                "triangles reach across many leaves; use a BVH (--accel bvh2), which references "
+                "each triangle once",
+                name_, max_references_, max_per_triangle_));
+    }
+
+    /// A node's choice: a leaf (axis -1), or a plane and what lies on each side of it.
+    struct Cut {
+        int axis = -1;
+        float split = 0;
+        bool bad = false;
+        References below, above;
+        Aabb below_box, above_box;
+    };
+
+    /// Builds `refs`' subtree on this thread at the end of `out`.
+    void build(const Aabb& box, References refs, uint32_t depth, uint32_t bad_cuts,
+               Subtree& out) const {
+        const size_t index = out.nodes.size();
+        out.nodes.emplace_back();
+        Cut cut = choose_cut(box, refs, depth, bad_cuts);
+        if (cut.axis < 0) {
+            KdNode& leaf = out.nodes[index];
+            leaf.first = uint32_t(out.references.size());
+            leaf.count = uint32_t(refs.size());
+            out.references.insert(out.references.end(), refs.begin(), refs.end());
+            // The subtree's references join the total when it is done (one thread's
+            // additions to a shared count would stall the other's).
+            check_references(references_.load(std::memory_order_relaxed) + out.references.size());
+            return;
+        }
+        const uint32_t below_cuts = bad_cuts + cut.bad;
+        build(cut.below_box, std::move(cut.below), depth + 1, below_cuts, out);
+        const auto right = uint32_t(out.nodes.size());
+        build(cut.above_box, std::move(cut.above), depth + 1, below_cuts, out);
+        KdNode& interior = out.nodes[index];
+        interior.axis = uint32_t(cut.axis);
+        interior.split = cut.split;
+        interior.right_child = right;
+    }
+
+    /// The heuristic's plane for the node of `refs` and its sides (freeing `refs`), or a leaf
+    /// (leaving `refs` as they are).
+    Cut choose_cut(const Aabb& box, References& refs, uint32_t depth, uint32_t bad_cuts) const {
+        const auto [axis, split, binned_below, binned_above] = choose_split(box, refs, depth);
+        Cut out;
+        const BoxCut box_cut(box, uint32_t(std::max(axis, 0)));
         if (axis >= 0) {
             const auto k = uint32_t(axis);
             const glm::vec3 extent = box.hi - box.lo;
             const auto [lo, hi] = project(k, box);
             const float width = k < 3 ? extent[axis] : float(hi - lo);
             const float margin = width * kKdMargin + std::abs(split) * 0x1p-20f;
+            // The margin adds the few triangles near the plane to the binned counts.
+            out.below.reserve(binned_below + binned_below / 16 + 16);
+            out.above.reserve(binned_above + binned_above / 16 + 16);
             for (uint32_t r : refs) {
-                if (lo_[r * directions_ + k] <= double(split + margin)) left.push_back(r);
-                if (hi_[r * directions_ + k] >= double(split - margin)) right.push_back(r);
+                const Range& range = ranges_[r * directions_ + k];
+                if (range.lo <= double(split + margin)) out.below.push_back(r);
+                if (range.hi >= double(split - margin)) out.above.push_back(r);
             }
         }
+        const size_t nl = out.below.size(), nr = out.above.size();
         // A BSP split that leaves one side with every triangle and still gives the other some is
         // a bad cut (one that cuts off empty space is not); past kMaxBadCuts on a path the node
         // stays a leaf (the kd-tree builds without this limit).
-        const bool bad = directions_ > 3 && !left.empty() && !right.empty() &&
-                         (left.size() == refs.size() || right.size() == refs.size());
+        out.bad = directions_ > 3 && nl != 0 && nr != 0 && (nl == refs.size() || nr == refs.size());
         // The margin puts triangles on or near the plane on both sides, which the binned cost
         // did not count: a split that then costs more than the leaf (or moves nothing) is none.
-        if (axis < 0 || (bad && bad_cuts == kMaxBadCuts) ||
-            split_cost(cut, axis, split, left.size(), right.size()) >=
-                kIntersectionCost * double(refs.size())) {
-            // Refused as soon as the leaves hold too many, before they fill the memory.
-            const uint64_t total = references_ += refs.size();
-            if (total > max_references_)
-                throw std::invalid_argument(fmt::format(
-                    "{}: more than {} leaf references, {:g} per triangle, the limit: the "
-                    "scene's triangles reach across many leaves; use a BVH (--accel bvh2), "
-                    "which references each triangle once",
-                    name_, max_references_, max_per_triangle_));
-            out->references = std::move(refs);
-            return out;
-        }
+        if (axis < 0 || (out.bad && bad_cuts == kMaxBadCuts) ||
+            split_cost(box_cut, axis, split, nl, nr) >= kIntersectionCost * double(refs.size()))
+            return {};
         refs = {};
-        const auto [left_box, right_box] = cut.halves(split);
-        out->axis = axis;
-        out->split = split;
-        if (left.size() + right.size() > kParallelReferences)
-            tbb::parallel_invoke(
-                [&] { out->below = build(left_box, std::move(left), depth + 1, bad_cuts + bad); },
-                [&] {
-                    out->above = build(right_box, std::move(right), depth + 1, bad_cuts + bad);
-                });
-        else {
-            out->below = build(left_box, std::move(left), depth + 1, bad_cuts + bad);
-            out->above = build(right_box, std::move(right), depth + 1, bad_cuts + bad);
-        }
+        std::tie(out.below_box, out.above_box) = box_cut.halves(split);
+        out.axis = axis;
+        out.split = split;
         return out;
     }
 
-private:
-    /// The SAH's best plane over kBins bins per axis, or axis -1 when a leaf costs less.
-    std::pair<int, float> choose_split(const Aabb& box, const std::vector<uint32_t>& refs,
-                                       uint32_t depth) const {
+    /// A plane the heuristic chose (axis -1: a leaf costs less), and the triangles its bins
+    /// put on each side.
+    struct Split {
+        int axis = -1;
+        float split = 0;
+        uint32_t left = 0, right = 0;
+    };
+
+    /// One orientation's bins over a node: bin b holds n.x in [lo + b w, lo + (b + 1) w),
+    /// w = extent / kBins, by the quotient (x - lo) / extent * kBins.
+    struct Bins {
+        double lo, hi, extent, scale;  ///< scale: kBins / extent
+        std::array<uint32_t, kBins> starts, ends;
+
+        int bin(float x) const {
+            // A product is cheaper than the quotient and rounds to the same bin unless the two
+            // fall either side of a bin edge: a product within 1e-6 of one takes the quotient.
+            const double t = (double(x) - lo) * scale, whole = std::floor(t);
+            const double b = t - whole > 1e-6 && t - whole < 1 - 1e-6
+                                 ? whole
+                                 : std::floor((double(x) - lo) / extent * kBins);
+            return int(std::clamp(b, 0.0, double(kBins - 1)));
+        }
+    };
+
+    /// The SAH's best plane over kBins bins per orientation.
+    Split choose_split(const Aabb& box, const References& refs, uint32_t depth) const {
         const double n = double(refs.size());
-        if (refs.size() <= 1 || depth >= depth_limit_) return {-1, 0.f};
+        if (refs.size() <= 1 || depth >= depth_limit_) return {};
         const double box_area = area(box.lo, box.hi);
-        double best_cost = kIntersectionCost * n;
-        std::pair<int, float> best{-1, 0.f};
-        for (int axis = 0; axis < int(directions_); ++axis) {
-            const auto k = uint32_t(axis);
-            const auto [lo, hi] = project(k, box);
-            const double extent = hi - lo;
-            if (!(extent > 0) || box_area <= 0) continue;
-            const BoxCut cut(box, k);
-            std::array<uint32_t, kBins> starts{}, ends{};
-            const auto bin = [&](float x) {
-                return int(std::clamp(std::floor((double(x) - lo) / extent * kBins), 0.0,
-                                      double(kBins - 1)));
-            };
-            for (uint32_t r : refs) {
-                ++starts[size_t(bin(lo_[r * directions_ + k]))];
-                ++ends[size_t(bin(hi_[r * directions_ + k]))];
+        if (box_area <= 0) return {};
+        // Every orientation's bins in one pass over the references, which touches each
+        // triangle's ranges once. Most nodes are small: only the bins used are cleared.
+        std::array<Bins, kBspPlaneDirections> bins;
+        std::array<uint32_t, kBspPlaneDirections> binned;
+        uint32_t orientations = 0;
+        for (uint32_t k = 0; k < directions_; ++k) {
+            Bins& b = bins[orientations];
+            std::tie(b.lo, b.hi) = project(k, box);
+            b.extent = b.hi - b.lo;
+            if (!(b.extent > 0)) continue;
+            b.scale = kBins / b.extent;
+            b.starts.fill(0);
+            b.ends.fill(0);
+            binned[orientations++] = k;
+        }
+        for (uint32_t r : refs) {
+            const Range* range = &ranges_[r * directions_];
+            for (uint32_t o = 0; o < orientations; ++o) {
+                Bins& b = bins[o];
+                const Range& x = range[binned[o]];
+                ++b.starts[size_t(b.bin(float(x.lo)))];
+                ++b.ends[size_t(b.bin(float(x.hi)))];
             }
+        }
+        double best_cost = kIntersectionCost * n;
+        Split best;
+        for (uint32_t o = 0; o < orientations; ++o) {
+            const uint32_t k = binned[o];
+            const int axis = int(k);
+            const Bins& b = bins[o];
+            const double lo = b.lo, hi = b.hi, extent = b.extent;
+            const BoxCut cut(box, k);
             // Plane b lies between bins b - 1 and b: the triangles starting before it reach
             // left, those ending at or after it reach right.
-            std::array<uint32_t, kBins> right_count{};
+            std::array<uint32_t, kBins> right_count;  // [1, kBins)
             uint32_t sum = 0;
-            for (int b = kBins - 1; b >= 1; --b) {
-                sum += ends[size_t(b)];
-                right_count[size_t(b)] = sum;
+            for (int p = kBins - 1; p >= 1; --p) {
+                sum += b.ends[size_t(p)];
+                right_count[size_t(p)] = sum;
             }
-            const auto split_at = [&](int b) { return float(lo + extent * b / kBins); };
+            const auto split_at = [&](int p) { return float(lo + extent * p / kBins); };
             // A diagonal plane's price clips the box, so most are bounded first: the half below
             // only grows with the split and the half above only shrinks, so the areas at the
-            // priced planes around b bound b's from below (a little less, for the rounding).
+            // priced planes around p bound p's from below (a little less, for the rounding).
             // A plane whose bound is not below the best so far cannot become the best: the
             // choice is the one pricing every plane gives.
             std::array<std::pair<double, double>, kBins> priced{};  // (0, 0): no bound
             if (k >= 3)
-                for (int b = 1; b < kBins + kPricedEvery - 1; b += kPricedEvery) {
-                    const int p = std::min(b, kBins - 1);  // ... and the last plane
-                    const float split = split_at(p);
-                    if (split > lo && split < hi) priced[size_t(p)] = cut.half_areas(split);
+                for (int p = 1; p < kBins + kPricedEvery - 1; p += kPricedEvery) {
+                    const int q = std::min(p, kBins - 1);  // ... and the last plane
+                    const float split = split_at(q);
+                    if (split > lo && split < hi) priced[size_t(q)] = cut.half_areas(split);
                 }
+            const auto valid = [&](int p) {
+                const float split = split_at(p);
+                return split > lo && split < hi;
+            };
+            // Planes p - 1 and p have the same counts when no triangle starts or ends in bin
+            // p - 1. Along such a run an axis plane's cost is linear in the split, rising by
+            // (nl - nr) times the cross-section's perimeter (in the halves' areas, which round
+            // monotonically): with nl > nr only the run's first valid plane can be the best,
+            // with nl < nr only its last; with nl == nr every plane is priced.
+            const auto same_counts = [&](int p) {  // planes p - 1 and p
+                return b.starts[size_t(p - 1)] == 0 && b.ends[size_t(p - 1)] == 0;
+            };
             uint32_t left_count = 0;
-            for (int b = 1; b < kBins; ++b) {
-                left_count += starts[size_t(b - 1)];
-                const float split = split_at(b);
+            for (int p = 1; p < kBins; ++p) {
+                left_count += b.starts[size_t(p - 1)];
+                const float split = split_at(p);
                 if (!(split > lo && split < hi)) continue;
-                const uint32_t nl = left_count, nr = right_count[size_t(b)];
+                const uint32_t nl = left_count, nr = right_count[size_t(p)];
+                if (k < 3 && ((nl > nr && p > 1 && same_counts(p) && valid(p - 1)) ||
+                              (nl < nr && p + 1 < kBins && same_counts(p + 1) && valid(p + 1))))
+                    continue;
                 if (k >= 3 && (nl == 0 || nr == 0)) continue;  // split_cost: infinite
                 double cost;
-                if (k >= 3 && (b - 1) % kPricedEvery == 0) {
-                    cost = sah_cost(priced[size_t(b)].first, priced[size_t(b)].second, box_area, nl,
+                if (k >= 3 && (p - 1) % kPricedEvery == 0) {
+                    cost = sah_cost(priced[size_t(p)].first, priced[size_t(p)].second, box_area, nl,
                                     nr);
                 } else if (k >= 3) {
-                    const int below = b - (b - 1) % kPricedEvery;
+                    const int below = p - (p - 1) % kPricedEvery;
                     const int above = std::min(below + kPricedEvery, kBins - 1);
                     const double bound =
                         sah_cost(priced[size_t(below)].first * kBoundSlack,
@@ -305,7 +430,7 @@ private:
                 }
                 if (cost < best_cost) {
                     best_cost = cost;
-                    best = {axis, split};
+                    best = {axis, split, nl, nr};
                 }
             }
         }
@@ -334,34 +459,45 @@ private:
     uint64_t max_references_;
     double max_per_triangle_;
     uint32_t directions_;
-    std::vector<double> lo_, hi_;  ///< each triangle's range of n.x, directions_ per triangle
+    struct Range {
+        double lo, hi;
+    };
+    std::vector<Range> ranges_;  ///< each triangle's range of n.x, directions_ per triangle
     mutable std::atomic<uint64_t> references_{0};
 };
 
-/// Lays `node`'s subtree out depth-first at the end of the tree's nodes and references.
-void flatten(const BuildNode& node, KdTree& tree) {
-    const size_t index = tree.nodes.size();
-    tree.nodes.emplace_back();
+/// The nodes and references of `node`'s tree.
+std::pair<size_t, size_t> sizes(const TopNode& node) {
+    if (node.axis < 0) return {node.subtree.nodes.size(), node.subtree.references.size()};
+    const auto [below_nodes, below_refs] = sizes(*node.below);
+    const auto [above_nodes, above_refs] = sizes(*node.above);
+    return {1 + below_nodes + above_nodes, below_refs + above_refs};
+}
+
+/// Lays `node`'s tree out depth-first at the end of the tree's nodes and references, freeing
+/// its subtrees as it goes.
+void lay_out(TopNode& node, KdTree& tree) {
     if (node.axis < 0) {
-        KdNode& leaf = tree.nodes[index];
-        leaf.first = uint32_t(tree.references.size());
-        leaf.count = uint32_t(node.references.size());
-        tree.references.insert(tree.references.end(), node.references.begin(),
-                               node.references.end());
+        const auto node_base = uint32_t(tree.nodes.size());
+        const auto reference_base = uint32_t(tree.references.size());
+        for (KdNode n : node.subtree.nodes) {
+            (n.is_leaf() ? n.first : n.right_child) += n.is_leaf() ? reference_base : node_base;
+            tree.nodes.push_back(n);
+        }
+        tree.references.insert(tree.references.end(), node.subtree.references.begin(),
+                               node.subtree.references.end());
+        node.subtree = {};
         return;
     }
-    flatten(*node.below, tree);
+    const size_t index = tree.nodes.size();
+    tree.nodes.emplace_back();
+    lay_out(*node.below, tree);
     const auto right = uint32_t(tree.nodes.size());
-    flatten(*node.above, tree);
+    lay_out(*node.above, tree);
     KdNode& interior = tree.nodes[index];
     interior.axis = uint32_t(node.axis);
     interior.split = node.split;
     interior.right_child = right;
-}
-
-uint64_t references_of(const BuildNode& node) {
-    return node.axis < 0 ? node.references.size()
-                         : references_of(*node.below) + references_of(*node.above);
 }
 
 void fill_stats(KdTree& tree) {
@@ -405,15 +541,17 @@ KdTree build_kdtree(std::span<const Triangle> triangles, const KdTreeConfig& con
             ? config.max_depth
             : std::min(kKdMaxDepth, uint32_t(8 + 1.3 * std::log2(double(triangles.size())) + 0.5));
     tree.stats.depth_limit = limit;
-    std::vector<uint32_t> all(triangles.size());
+    References all(triangles.size());
     for (uint32_t i = 0; i < all.size(); ++i)
         all[i] = i;
-    const std::unique_ptr<BuildNode> root =
+    const std::unique_ptr<TopNode> root =
         Builder(triangles, limit, config.max_references_per_triangle,
                 config.general_planes ? kBspPlaneDirections : 3, name)
             .build(tree.bounds, std::move(all), 0, 0);
-    tree.references.reserve(references_of(*root));
-    flatten(*root, tree);
+    const auto [nodes, references] = sizes(*root);
+    tree.nodes.reserve(nodes);
+    tree.references.reserve(references);
+    lay_out(*root, tree);
     fill_stats(tree);
     return tree;
 }

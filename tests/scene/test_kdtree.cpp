@@ -3,6 +3,7 @@
 // limits are enforced with a clear message; the same for the BSP tree it builds with general
 // planes.
 #include <algorithm>
+#include <bit>
 #include <tuple>
 #include <vector>
 
@@ -10,6 +11,7 @@
 #include <oneapi/tbb/global_control.h>
 
 #include "sim/scene/kdtree.hpp"
+#include "sim/scene/load_scene.hpp"
 #include "tests/scene/scene_test_util.hpp"
 
 using namespace tpsim::scene;
@@ -99,6 +101,38 @@ TEST_CASE("The kd-tree is the same on one thread and on many", "[kdtree]") {
                a.first == b.first && a.count == b.count));
     }
     CHECK(single.references == many.references);
+}
+
+/// FNV-1a over every field of every node, then the references: equal digests mean the same tree.
+uint64_t digest(const KdTree& tree) {
+    uint64_t h = 14695981039346656037ull;
+    const auto add = [&](uint32_t word) {
+        for (int byte = 0; byte < 4; ++byte) {
+            h ^= (word >> (8 * byte)) & 0xff;
+            h *= 1099511628211ull;
+        }
+    };
+    for (const KdNode& node : tree.nodes) {
+        add(node.axis);
+        add(std::bit_cast<uint32_t>(node.split));
+        add(node.right_child);
+        add(node.first);
+        add(node.count);
+    }
+    for (uint32_t r : tree.references)
+        add(r);
+    return h;
+}
+
+TEST_CASE("The kd-tree and the BSP tree of pinned inputs are the trees they were", "[kdtree]") {
+    // A change to the builder that moves these digests moves every kd-tree and BSP figure in
+    // docs/accel.md: a speed-up must keep them.
+    const auto bunny = load_scene(TPSIM_SCENES_DIR "/bunny.toml").triangles;
+    CHECK(digest(build_kdtree(bunny)) == 0x7b14d9b606529b47ull);
+    CHECK(digest(build_kdtree(soup(20000, 9, 0.5f))) == 0x3ef964ff1ad43e0full);
+    KdTreeConfig bsp;
+    bsp.general_planes = true;
+    CHECK(digest(build_kdtree(soup(6000, 3, 0.5f), bsp)) == 0xe0f3727f4c6436a9ull);
 }
 
 TEST_CASE("kd-tree limits: depth, references per triangle, bad input", "[kdtree]") {
