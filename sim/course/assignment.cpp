@@ -106,8 +106,9 @@ void read_render(const Reader& r, const toml::table& t, const std::filesystem::p
 }
 
 void read_image(const Reader& r, const toml::table& t, Assignment& a) {
-    r.allow_keys(t, "image.",
-                 {"min_psnr", "tolerance", "max_differing", "block", "brighter", "darker"});
+    r.allow_keys(
+        t, "image.",
+        {"min_psnr", "tolerance", "max_differing", "block", "brighter", "darker", "mixed"});
     if (auto* n = t.get("min_psnr")) a.image.min_psnr = r.number(*n, "image.min_psnr", 0, 200);
     if (auto* n = t.get("tolerance"))
         a.image.tolerance = int(r.integer(*n, "image.tolerance", 0, 255));
@@ -116,6 +117,7 @@ void read_image(const Reader& r, const toml::table& t, Assignment& a) {
     if (auto* n = t.get("block")) a.image.block = int(r.integer(*n, "image.block", 1, 64));
     if (auto* n = t.get("brighter")) a.hints.brighter = r.string(*n, "image.brighter");
     if (auto* n = t.get("darker")) a.hints.darker = r.string(*n, "image.darker");
+    if (auto* n = t.get("mixed")) a.hints.mixed = r.string(*n, "image.mixed");
 }
 
 /// Each entry of an array of tables, with its "name[i]" for messages.

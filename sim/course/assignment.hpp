@@ -47,6 +47,7 @@ struct ImageThresholds {
 struct ImageHints {
     std::string brighter;  ///< most differing pixels are brighter than the reference
     std::string darker;    ///< most differing pixels are darker than the reference
+    std::string mixed;     ///< neither: the differing pixels are brighter and darker both
 };
 
 struct Assignment {

@@ -143,6 +143,9 @@ std::string likely_cause(const Rgb8& image, const Rgb8& ref, const ImageComparis
         return fmt::format("most of them are brighter than the reference: {}", a.hints.brighter);
     if (c.brighter_share <= 0.25 && !a.hints.darker.empty())
         return fmt::format("most of them are darker than the reference: {}", a.hints.darker);
+    if (!a.hints.mixed.empty())
+        return fmt::format("{} of them brighter, {} darker than the reference: {}",
+                           percent(c.brighter_share), percent(1 - c.brighter_share), a.hints.mixed);
     return fmt::format("{} of them brighter, {} darker than the reference; see the difference "
                        "image",
                        percent(c.brighter_share), percent(1 - c.brighter_share));
