@@ -127,12 +127,18 @@ Estimate estimate(const timing::ChipConfig& chip, const Events& events) {
          (events.register_reads + events.register_writes) * pj(e.register_access_pj),
          tps * mm2(a.register_file_um2)});
     const double ls = chip.tp.local_store_bytes, ls_default = defaults.tp.local_store_bytes;
+    const std::optional<double> ls_point = cacti_local_store_mm2(ls);
+    const std::optional<double> ls_cited = cacti_local_store_mm2(ls_default);
     out.parts.push_back(
         {"local_stores", "local stores",
          "loads and stores x energy.local_store_access_pj scaled to tp.local_store_bytes",
-         "TPs x area.local_store_um2 scaled to tp.local_store_bytes",
+         ls_point && ls_cited
+             ? fmt::format("TPs x area.local_store_um2 scaled by simtrax's 65 nm figure for {} B",
+                           ls)
+             : "TPs x area.local_store_um2 scaled to tp.local_store_bytes by the power law",
          events.local_store_accesses * pj(energy_of(e.local_store_access_pj, ls, ls_default, 1, 1)),
-         tps * mm2(area_of(a.local_store_um2, ls, ls_default, 1, 1))});
+         tps * mm2(ls_point && ls_cited ? a.local_store_um2 * (*ls_point / *ls_cited)
+                                        : area_of(a.local_store_um2, ls, ls_default, 1, 1))});
     const double ib = chip.icache.banks, ib_default = defaults.icache.banks;
     // The cited I-cache holds 4 KiB (TRaX's, which never misses: icache.size_bytes = 0); a
     // finite I-cache scales from it.
@@ -145,18 +151,32 @@ Estimate estimate(const timing::ChipConfig& chip, const Events& events) {
          events.icache_fetches *
              pj(energy_of(e.icache_fetch_pj, is, kCitedIcacheBytes, ib, ib_default)),
          icaches * mm2(area_of(a.icache_um2, is, kCitedIcacheBytes, ib, ib_default))});
+    // A cache the CACTI table holds is costed from its entry (the cited figure times the
+    // entry's ratio to the default geometry's); between entries, by the power law.
     const auto cache_part = [&](std::string name, const timing::CacheConfig& c,
                                 const timing::CacheConfig& d, double accesses, double access_pj,
                                 double um2, double count) {
-        return Part{name,
-                    fmt::format("{} caches", name == "l1" ? "L1" : "L2"),
-                    fmt::format("loads, stores and line fills x energy.{0}_access_pj scaled to "
-                                "{0}.size_bytes and {0}.banks",
-                                name),
-                    fmt::format("{0}s x area.{0}_um2 scaled to {0}.size_bytes and {0}.banks", name),
-                    accesses *
-                        pj(energy_of(access_pj, c.size_bytes, d.size_bytes, c.banks, d.banks)),
-                    count * mm2(area_of(um2, c.size_bytes, d.size_bytes, c.banks, d.banks))};
+        const std::optional<SramPoint> point = cacti_dcache_point(c.size_bytes, c.banks);
+        const std::optional<SramPoint> cited = cacti_dcache_point(d.size_bytes, d.banks);
+        const std::string scaled =
+            point && cited ? fmt::format("scaled by the CACTI table's entry for {} KiB, {} banks",
+                                         c.size_bytes / 1024, c.banks)
+                           : fmt::format("scaled to {0}.size_bytes and {0}.banks by the power law "
+                                         "(no CACTI table entry for {1} B, {2} banks)",
+                                         name, c.size_bytes, c.banks);
+        const double pj_each =
+            point && cited ? access_pj * (point->energy_nj / cited->energy_nj)
+                           : energy_of(access_pj, c.size_bytes, d.size_bytes, c.banks, d.banks);
+        const double um2_each = point && cited
+                                    ? um2 * (point->area_mm2 / cited->area_mm2)
+                                    : area_of(um2, c.size_bytes, d.size_bytes, c.banks, d.banks);
+        return Part{
+            name,
+            fmt::format("{} caches", name == "l1" ? "L1" : "L2"),
+            fmt::format("loads, stores and line fills x energy.{}_access_pj {}", name, scaled),
+            fmt::format("{0}s x area.{0}_um2 {1}", name, scaled),
+            accesses * pj(pj_each),
+            count * mm2(um2_each)};
     };
     out.parts.push_back(
         cache_part("l1", chip.l1, defaults.l1, events.l1_accesses, e.l1_access_pj, a.l1_um2, tms));

@@ -3,6 +3,7 @@
 // events only). docs/energy.md lists every cost, its source and what the model leaves out.
 #pragma once
 #include <array>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -69,6 +70,20 @@ Estimate estimate(const timing::ChipConfig& chip, const Events& events);
 /// banks)^bank_exponent.
 double scale_sram(double cost, double size_bytes, double default_size_bytes, double banks,
                   double default_banks, double size_exponent, double bank_exponent);
+
+/// An entry of the CACTI table the cache figures are cited from.
+struct SramPoint {
+    double size_bytes = 0, banks = 0;
+    double area_mm2 = 0, energy_nj = 0;  ///< per cache; per access
+};
+
+/// The 65 nm CACTI table's entry for a cache of this size and bank count (simtrax
+/// dcacheparams.txt, 64-byte lines), if it has one.
+std::optional<SramPoint> cacti_dcache_point(double size_bytes, double banks);
+
+/// The area of one local store of this size that simtrax's 65 nm figures give (4 KiB from its
+/// CACTI table icacheparams.txt, 512 B from 65nm_config.txt, the TRaX papers' TM), if they do.
+std::optional<double> cacti_local_store_mm2(double size_bytes);
 
 /// Register reads and writes of every executed instruction, from its opcode's operands:
 /// rs1, rs2 and rs3 read, rd written (x0 included: the format names a register).

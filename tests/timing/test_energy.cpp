@@ -138,10 +138,11 @@ TEST_CASE("SRAM costs scale from the default geometry by the fitted power law", 
     CHECK(a / 207212 > 0.52);
     CHECK(a / 207212 < 1.51);
 
-    // Through the estimate: the same L1 charges each access the scaled cost.
+    // Through the estimate: an L1 between the table's entries (24 KiB, 8 banks) charges each
+    // access the scaled cost.
     ChipConfig c = one_tp();
-    c.l1.size_bytes = 8192;
-    c.l1.banks = 4;
+    c.l1.size_bytes = 24576;
+    c.l1.banks = 8;
     energy::Events events;
     events.l1_accesses = 1000;
     const energy::Estimate estimate = energy::estimate(c, events);
@@ -151,8 +152,11 @@ TEST_CASE("SRAM costs scale from the default geometry by the fitted power law", 
         FAIL("no part " << name);
         return energy::Part{};
     };
-    CHECK(part("l1").joules == Approx(1000 * e * 1e-12).epsilon(1e-12));
-    CHECK(part("l1").area_mm2 == Approx(a * 1e-6).epsilon(1e-12));
+    const double between_pj = energy::scale_sram(220.453, 24576, 32768, 8, 8, 0.355, 0.176);
+    const double between_um2 = energy::scale_sram(775049, 24576, 32768, 8, 8, 0.682, 0.446);
+    CHECK(part("l1").joules == Approx(1000 * between_pj * 1e-12).epsilon(1e-12));
+    CHECK(part("l1").area_mm2 == Approx(between_um2 * 1e-6).epsilon(1e-12));
+    CHECK_THAT(part("l1").energy_rule, Catch::Contains("by the power law (no CACTI table entry"));
 
     // The I-cache's cited 4 KiB is what an I-cache that never misses (size_bytes = 0) costs; a
     // finite one of 16 KiB scales from it.
@@ -173,6 +177,46 @@ TEST_CASE("SRAM costs scale from the default geometry by the fitted power law", 
           Approx(never_misses.joules * std::pow(4.0, c.energy.sram_size_exponent)).epsilon(1e-12));
     CHECK(icache_part(icache).area_mm2 ==
           Approx(never_misses.area_mm2 * std::pow(4.0, c.area.sram_size_exponent)).epsilon(1e-12));
+}
+
+TEST_CASE("A cache the CACTI table holds is costed from its entry, not the fit", "[energy]") {
+    // simtrax dcacheparams.txt, 65 nm, 64 B lines: 16 KiB in 8 banks is 0.204198 nJ and
+    // 0.650707 mm^2 (the power law gives 172 pJ and 0.483 mm^2); 8 KiB in 4 banks 0.118944 nJ
+    // and 0.207212 mm^2; a 1 MiB L2 in 16 banks 0.828002 nJ and 10.042545 mm^2.
+    energy::Events events;
+    events.l1_accesses = 1000;
+    events.l2_accesses = 1000;
+    const auto part = [&](const ChipConfig& chip, std::string_view name) {
+        for (const energy::Part& p : energy::estimate(chip, events).parts)
+            if (p.name == name) return p;
+        FAIL("no part " << name);
+        return energy::Part{};
+    };
+    ChipConfig c = one_tp();
+    c.l1.size_bytes = 16384;
+    CHECK(part(c, "l1").joules == Approx(1000 * 204.198e-12).epsilon(1e-9));
+    CHECK(part(c, "l1").area_mm2 == Approx(0.650707).epsilon(1e-9));
+    CHECK_THAT(part(c, "l1").area_rule,
+               Catch::Contains("scaled by the CACTI table's entry for 16 KiB, 8 banks"));
+    c.l1.size_bytes = 8192;
+    c.l1.banks = 4;
+    CHECK(part(c, "l1").joules == Approx(1000 * 118.944e-12).epsilon(1e-9));
+    CHECK(part(c, "l1").area_mm2 == Approx(0.207212).epsilon(1e-9));
+    c.l2.size_bytes = 1 << 20;
+    CHECK(part(c, "l2").joules == Approx(1000 * 828.002e-12).epsilon(1e-9));
+    CHECK(part(c, "l2").area_mm2 == Approx(10.042545).epsilon(1e-9));
+    // The default geometry is the cited figure itself, and a changed cited figure scales
+    // with it.
+    const ChipConfig defaults = one_tp();
+    CHECK(part(defaults, "l1").joules == 1000 * (defaults.energy.l1_access_pj * 1e-12));
+    // The TRaX papers' 512-byte local store (simtrax 65nm_config.txt): 19,470 um^2.
+    ChipConfig papers = one_tp();
+    papers.tp.local_store_bytes = 512;
+    CHECK(part(papers, "local_stores").area_mm2 == Approx(0.019470).epsilon(1e-9));
+    ChipConfig doubled = one_tp();
+    apply_override(doubled, "energy.l1_access_pj=440.906");
+    doubled.l1.size_bytes = 16384;
+    CHECK(part(doubled, "l1").joules == Approx(2 * 1000 * 204.198e-12).epsilon(1e-9));
 }
 
 TEST_CASE("DRAM energy is per activate and per line, scaled to the line size", "[energy]") {
