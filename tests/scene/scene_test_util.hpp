@@ -32,4 +32,20 @@ inline std::vector<Triangle> soup(uint32_t count, uint32_t seed, float size) {
     return triangles;
 }
 
+/// FNV-1a over 32-bit words, byte by byte: the scene tests' digests of built structures (equal
+/// digests mean the same structure).
+class Fnv {
+public:
+    void add(uint32_t word) {
+        for (int byte = 0; byte < 4; ++byte) {
+            hash_ ^= (word >> (8 * byte)) & 0xff;
+            hash_ *= 1099511628211ull;
+        }
+    }
+    uint64_t hash() const { return hash_; }
+
+private:
+    uint64_t hash_ = 14695981039346656037ull;
+};
+
 }  // namespace tpsim::scene::testing

@@ -13,6 +13,7 @@
 #include "sim/scene/bvh.hpp"
 #include "sim/scene/load_scene.hpp"
 #include "sim/scene/procedural.hpp"
+#include "tests/scene/scene_test_util.hpp"
 
 using namespace tpsim::scene;
 
@@ -127,13 +128,8 @@ const BvhBuilder kBuilders[] = {BvhBuilder::sweep, BvhBuilder::binned};
 /// FNV-1a over every field of every node, then the triangle order: equal digests mean the same
 /// memory image of the tree.
 uint64_t digest(const Bvh& bvh) {
-    uint64_t h = 14695981039346656037ull;
-    const auto add = [&](uint32_t word) {
-        for (int byte = 0; byte < 4; ++byte) {
-            h ^= (word >> (8 * byte)) & 0xff;
-            h *= 1099511628211ull;
-        }
-    };
+    testing::Fnv fnv;
+    const auto add = [&](uint32_t word) { fnv.add(word); };
     for (const BvhNode& node : bvh.nodes) {
         for (int k = 0; k < 3; ++k) {
             add(std::bit_cast<uint32_t>(node.bounds.lo[k]));
@@ -145,7 +141,7 @@ uint64_t digest(const Bvh& bvh) {
     }
     for (uint32_t t : bvh.triangle_order)
         add(t);
-    return h;
+    return fnv.hash();
 }
 
 /// The sweep builder's tree of `triangles` built on `threads` host threads (more than the host

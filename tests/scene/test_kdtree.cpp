@@ -105,13 +105,8 @@ TEST_CASE("The kd-tree is the same on one thread and on many", "[kdtree]") {
 
 /// FNV-1a over every field of every node, then the references: equal digests mean the same tree.
 uint64_t digest(const KdTree& tree) {
-    uint64_t h = 14695981039346656037ull;
-    const auto add = [&](uint32_t word) {
-        for (int byte = 0; byte < 4; ++byte) {
-            h ^= (word >> (8 * byte)) & 0xff;
-            h *= 1099511628211ull;
-        }
-    };
+    testing::Fnv fnv;
+    const auto add = [&](uint32_t word) { fnv.add(word); };
     for (const KdNode& node : tree.nodes) {
         add(node.axis);
         add(std::bit_cast<uint32_t>(node.split));
@@ -121,7 +116,7 @@ uint64_t digest(const KdTree& tree) {
     }
     for (uint32_t r : tree.references)
         add(r);
-    return h;
+    return fnv.hash();
 }
 
 TEST_CASE("The kd-tree and the BSP tree of pinned inputs are the trees they were", "[kdtree]") {

@@ -128,13 +128,8 @@ TEST_CASE("The octree is the same on one thread and on many", "[octree]") {
 /// FNV-1a over every field of every node, the references and the statistics: equal digests mean
 /// the same tree.
 uint64_t digest(const Octree& tree) {
-    uint64_t h = 14695981039346656037ull;
-    const auto add = [&](uint32_t word) {
-        for (int byte = 0; byte < 4; ++byte) {
-            h ^= (word >> (8 * byte)) & 0xff;
-            h *= 1099511628211ull;
-        }
-    };
+    testing::Fnv fnv;
+    const auto add = [&](uint32_t word) { fnv.add(word); };
     for (const OctreeNode& node : tree.nodes) {
         add(node.leaf);
         for (float c : node.centre)
@@ -150,7 +145,7 @@ uint64_t digest(const Octree& tree) {
     for (uint64_t field : {uint64_t(s.nodes), uint64_t(s.interior), uint64_t(s.leaves),
                            uint64_t(s.max_depth), s.references, uint64_t(s.max_leaf_triangles)})
         add(uint32_t(field));
-    return h;
+    return fnv.hash();
 }
 
 TEST_CASE("The octrees of pinned inputs are the trees they were", "[octree]") {
