@@ -72,22 +72,19 @@ float next_up(float x) {
     return -next_down(-x);
 }
 
-/// A box cut by planes n.x = split of one orientation, for every split the builder tries on it:
-/// the corners and their n.x are worked out once. Each half is exact for an axis; for a
-/// diagonal, it is the box of the corners on its side and the edge crossings, rounded outwards.
+/// A box cut by planes n.x = split of one orientation, for every split the builder tries on it.
+/// The orientations' components are 0 or +-1, so each half's bounding box has a closed form:
+/// the half below reaches along an axis a with n_a = +1 from lo_a to lo_a + (split - m), m the
+/// least n.x over the box (from hi_a down to hi_a - (split - m) where n_a = -1), and the half
+/// above likewise from the greatest n.x. Each half is exact for an axis; for a diagonal, it is
+/// rounded outwards.
 class BoxCut {
 public:
     BoxCut(const Aabb& box, uint32_t direction)
         : box_(box), direction_(direction),
           extent_(glm::max(glm::dvec3(box.hi) - glm::dvec3(box.lo), glm::dvec3(0))),
           area_(surface(extent_)) {
-        if (direction < 3) return;
-        for (int c = 0; c < 8; ++c) {
-            corner_[size_t(c)] =
-                glm::dvec3(c & 1 ? box.hi.x : box.lo.x, c & 2 ? box.hi.y : box.lo.y,
-                           c & 4 ? box.hi.z : box.lo.z);
-            n_dot_[size_t(c)] = project(direction, corner_[size_t(c)]);
-        }
+        std::tie(least_, greatest_) = project(direction, box);
     }
 
     /// The part below the plane (n.x <= split) and the part above.
@@ -98,28 +95,22 @@ public:
             above.lo[int(direction_)] = split;
             return {below, above};
         }
-        const glm::dvec3 none(std::numeric_limits<double>::infinity());
-        glm::dvec3 below_lo = none, below_hi = -none, above_lo = none, above_hi = -none;
-        const auto keep = [](glm::dvec3& lo, glm::dvec3& hi, const glm::dvec3& p) {
-            lo = glm::min(lo, p);
-            hi = glm::max(hi, p);
-        };
-        for (size_t c = 0; c < 8; ++c) {
-            const glm::dvec3& p = corner_[c];
-            const double sp = n_dot_[c] - double(split);
-            if (sp <= 0) keep(below_lo, below_hi, p);
-            if (sp >= 0) keep(above_lo, above_hi, p);
-            for (size_t a = 0; a < 3; ++a) {  // the edge from corner c along axis a, once
-                if (c >> a & 1) continue;
-                const size_t q = c | size_t(1) << a;
-                const double sq = n_dot_[q] - double(split);
-                if ((sp < 0) == (sq < 0)) continue;
-                const glm::dvec3 crossing = p + (corner_[q] - p) * (sp / (sp - sq));
-                keep(below_lo, below_hi, crossing);
-                keep(above_lo, above_hi, crossing);
+        const auto& n = trax::layout::kBspDirection[direction_];
+        const glm::dvec3 lo(box_.lo), hi(box_.hi);
+        glm::dvec3 below_lo = lo, below_hi = hi, above_lo = lo, above_hi = hi;
+        const double reach_below = double(split) - least_, reach_above = greatest_ - double(split);
+        for (int a = 0; a < 3; ++a) {
+            if (n[a] > 0) {
+                below_hi[a] = lo[a] + reach_below;
+                above_lo[a] = hi[a] - reach_above;
+            } else if (n[a] < 0) {
+                below_lo[a] = hi[a] - reach_below;
+                above_hi[a] = lo[a] + reach_above;
             }
         }
-        return {rounded_out(below_lo, below_hi), rounded_out(above_lo, above_hi)};
+        // Nothing on a side (a plane the heuristic does not choose) leaves that side the box.
+        return {reach_below >= 0 ? rounded_out(below_lo, below_hi) : box_,
+                reach_above >= 0 ? rounded_out(above_lo, above_hi) : box_};
     }
 
     /// The surface areas of the two halves, as area() of halves() gives them; for an axis,
@@ -139,8 +130,8 @@ public:
     double box_area() const { return area_; }
 
 private:
+    /// The box from lo to hi rounded outwards to floats, within the cut box.
     Aabb rounded_out(const glm::dvec3& lo, const glm::dvec3& hi) const {
-        if (!(lo.x <= hi.x)) return box_;  // nothing on that side (not chosen by the heuristic)
         Aabb out;
         for (int a = 0; a < 3; ++a) {
             out.lo[a] = std::max(box_.lo[a], next_down(float(lo[a])));
@@ -153,8 +144,7 @@ private:
     uint32_t direction_;
     glm::dvec3 extent_;
     double area_;
-    std::array<glm::dvec3, 8> corner_{};
-    std::array<double, 8> n_dot_{};
+    double least_ = 0, greatest_ = 0;  ///< n.x over the box
 };
 
 /// Triangle indices. Each level of the build makes new lists for both sides of its planes and
@@ -185,15 +175,13 @@ public:
             uint32_t directions, const char* name)
         : name_(name), depth_limit_(depth_limit),
           max_references_(uint64_t(max_per_triangle * double(triangles.size()))),
-          max_per_triangle_(max_per_triangle), directions_(directions),
+          max_per_triangle_(max_per_triangle), directions_(directions), triangles_(triangles),
           ranges_(triangles.size() * directions) {
-        for (size_t i = 0; i < triangles.size(); ++i) {
-            const Triangle& t = triangles[i];
+        for (size_t i = 0; i < triangles.size(); ++i)
             for (uint32_t k = 0; k < directions; ++k) {
-                const double a = project(k, t.v0), b = project(k, t.v1), c = project(k, t.v2);
-                ranges_[i * directions + k] = {std::min({a, b, c}), std::max({a, b, c})};
+                const auto [lo, hi] = exact_range(uint32_t(i), k);
+                ranges_[i * directions + k] = {float(lo), float(hi)};
             }
-        }
     }
 
     std::unique_ptr<TopNode> build(const Aabb& box, References refs, uint32_t depth,
@@ -223,6 +211,13 @@ public:
     }
 
 private:
+    /// Triangle t's range of n.x for orientation k, in double (exact for the axes).
+    std::pair<double, double> exact_range(uint32_t t, uint32_t k) const {
+        const Triangle& tri = triangles_[t];
+        const double a = project(k, tri.v0), b = project(k, tri.v1), c = project(k, tri.v2);
+        return {std::min({a, b, c}), std::max({a, b, c})};
+    }
+
     /// Refuses the build as soon as the leaves hold too many references, before they fill the
     /// memory.
     void check_references(uint64_t total) const {
@@ -284,10 +279,17 @@ private:
             // The margin adds the few triangles near the plane to the binned counts.
             out.below.reserve(binned_below + binned_below / 16 + 16);
             out.above.reserve(binned_above + binned_above / 16 + 16);
+            // Rounding to the nearest float keeps order, so the rounded range decides against
+            // a float bound unless it equals the bound; the exact range decides that tie.
+            const float below_bound = split + margin, above_bound = split - margin;
             for (uint32_t r : refs) {
                 const Range& range = ranges_[r * directions_ + k];
-                if (range.lo <= double(split + margin)) out.below.push_back(r);
-                if (range.hi >= double(split - margin)) out.above.push_back(r);
+                if (range.lo < below_bound ||
+                    (range.lo == below_bound && exact_range(r, k).first <= double(below_bound)))
+                    out.below.push_back(r);
+                if (range.hi > above_bound ||
+                    (range.hi == above_bound && exact_range(r, k).second >= double(above_bound)))
+                    out.above.push_back(r);
             }
         }
         const size_t nl = out.below.size(), nr = out.above.size();
@@ -358,8 +360,8 @@ private:
             for (uint32_t o = 0; o < orientations; ++o) {
                 Bins& b = bins[o];
                 const Range& x = range[binned[o]];
-                ++b.starts[size_t(b.bin(float(x.lo)))];
-                ++b.ends[size_t(b.bin(float(x.hi)))];
+                ++b.starts[size_t(b.bin(x.lo))];
+                ++b.ends[size_t(b.bin(x.hi))];
             }
         }
         double best_cost = kIntersectionCost * n;
@@ -459,10 +461,13 @@ private:
     uint64_t max_references_;
     double max_per_triangle_;
     uint32_t directions_;
+    std::span<const Triangle> triangles_;
+    /// Each triangle's range of n.x rounded to the nearest floats, directions_ per triangle:
+    /// the bins take floats, and half the bytes of doubles are half the memory traffic.
     struct Range {
-        double lo, hi;
+        float lo, hi;
     };
-    std::vector<Range> ranges_;  ///< each triangle's range of n.x, directions_ per triangle
+    std::vector<Range> ranges_;
     mutable std::atomic<uint64_t> references_{0};
 };
 
