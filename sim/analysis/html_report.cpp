@@ -530,14 +530,14 @@ void timeline(Page& page, const StatsFile& run) {
 
 void profile_table(Page& page, const std::vector<ProfileEntry>& entries, double total, bool lines) {
     constexpr size_t kShown = 20;
-    page.body << fmt::format("<h3>Top {} by cycles{}</h3>\n<table><tr>{}<th>function</th>"
+    page.body << fmt::format("<h3>Top {} by cycles{}</h3>\n<table{}><tr>{}<th>function</th>"
                              "<th class=\"num\">share</th><th class=\"num\">cycles</th>"
                              "<th class=\"num\">executions</th><th class=\"num\">stall "
                              "cycles</th><th class=\"num\">L1 misses</th><th class=\"num\">DRAM "
                              "B</th></tr>\n",
                              lines ? "source lines" : "functions",
                              entries.size() > kShown ? fmt::format(" (of {})", entries.size()) : "",
-                             lines ? "<th>line</th>" : "");
+                             lines ? " class=\"lines\"" : "", lines ? "<th>line</th>" : "");
     for (size_t i = 0; i < std::min(kShown, entries.size()); ++i) {
         const ProfileEntry& e = entries[i];
         double stalls = 0;
