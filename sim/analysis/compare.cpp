@@ -319,10 +319,6 @@ constexpr const char* kWithinNote =
     "~ after a ratio: the two values differ by less than their intervals together, so the "
     "estimates cannot tell them apart";
 
-std::string run_letter(size_t run) {
-    return run < 26 ? std::string(1, char('A' + run)) : fmt::format("R{}", run + 1);
-}
-
 std::string image_line(const ImageDifference& d) {
     if (!d.compared()) return d.note;
     if (d.differing_pixels == 0) return fmt::format("identical ({} pixels)", d.pixels);
@@ -616,6 +612,10 @@ Row for_display(const Row& row) {
     for (double& half : shown.intervals)
         half *= chosen.scale;
     return shown;
+}
+
+std::string run_letter(size_t run) {
+    return run < 26 ? std::string(1, char('A' + run)) : fmt::format("R{}", run + 1);
 }
 
 std::string format_number(double value) {

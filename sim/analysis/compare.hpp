@@ -76,6 +76,9 @@ enum class Format { text, markdown, csv, json };
 void write_comparison(const Comparison& comparison, Format format, std::ostream& out,
                       bool colour = false);
 
+/// How the tables name run i: A, B, ... Z, then R27, R28 ...
+std::string run_letter(size_t run);
+
 /// A number as the tables show it: whole numbers exactly, others to 4 significant digits.
 std::string format_number(double value);
 

@@ -593,10 +593,6 @@ void host_line(Page& page, const std::vector<const StatsFile*>& runs) {
                   << line << "</p>\n";
 }
 
-std::string run_letter(size_t run) {
-    return run < 26 ? std::string(1, char('A' + run)) : fmt::format("R{}", run + 1);
-}
-
 /// A key without the '/'-separated segments every row of the section shares at its start and
 /// end: "chip/fu/fp_add/utilisation" is "fp_add" among the FU utilisation rows.
 std::string distinct_part(const Section& section, const std::string& key) {

@@ -37,6 +37,45 @@ std::optional<Image> read_pixels(const std::filesystem::path& path, std::string&
     return image;
 }
 
+/// The difference image write_difference_images writes.
+Rgb8 difference_image(const Rgb8& image, const Rgb8& ref, int tolerance) {
+    Rgb8 out{ref.width, ref.height, std::vector<uint8_t>(ref.pixels.size())};
+    for (size_t p = 0; p < ref.pixels.size(); p += 3) {
+        int largest = 0, signed_sum = 0, grey = 0;
+        for (int c = 0; c < 3; ++c) {
+            const int d = int(image.pixels[p + c]) - int(ref.pixels[p + c]);
+            largest = std::max(largest, std::abs(d));
+            signed_sum += d;
+            grey += ref.pixels[p + c];
+        }
+        uint8_t* d = &out.pixels[p];
+        if (largest <= tolerance) {
+            d[0] = d[1] = d[2] = uint8_t(grey / 3 / 4);
+            continue;
+        }
+        const uint8_t strength = uint8_t(std::min(255, 128 + largest));
+        d[0] = signed_sum > 0 ? strength : 0;
+        d[1] = 0;
+        d[2] = signed_sum > 0 ? 0 : strength;
+    }
+    return out;
+}
+
+/// The image with each pixel a `factor` x `factor` square, to see single pixels of a small
+/// image on a screen.
+Rgb8 enlarged(const Rgb8& image, int factor) {
+    Rgb8 out{image.width * factor, image.height * factor, {}};
+    out.pixels.resize(size_t(out.width) * out.height * 3);
+    for (int y = 0; y < out.height; ++y)
+        for (int x = 0; x < out.width; ++x)
+            std::copy_n(&image.pixels[(size_t(y / factor) * image.width + x / factor) * 3], 3,
+                        &out.pixels[(size_t(y) * out.width + x) * 3]);
+    return out;
+}
+
+/// Difference images are enlarged to about this many pixels across.
+constexpr int kEnlargedWidth = 512;
+
 }  // namespace
 
 ImageDifference compare_images(const std::filesystem::path& a, const std::filesystem::path& b) {
@@ -84,6 +123,44 @@ std::string png_bytes(const std::filesystem::path& path) {
     if (png.empty())
         throw Error(fmt::format("cannot convert image {} to PNG: {}", path.string(), error));
     return png;
+}
+
+Rgb8 read_rgb8(const std::filesystem::path& path, std::string_view what) {
+    render::Image file;
+    std::string error;
+    if (!render::read_image_file(path.string(), render::PixelType::UInt8, file, error))
+        throw Error(fmt::format("cannot read {} {}: {}", what, path.string(), error));
+    const int channels = file.layout.channels;
+    if (channels < 3)
+        throw Error(fmt::format("cannot read {} {}: it must be an RGB image", what, path.string()));
+    // Channels past the third (alpha) are dropped.
+    Rgb8 image{file.layout.width, file.layout.height, {}};
+    image.pixels.resize(size_t(image.width) * image.height * 3);
+    for (size_t pixel = 0; pixel < size_t(image.width) * image.height; ++pixel)
+        std::copy_n(file.bytes.begin() + pixel * channels, 3, image.pixels.begin() + pixel * 3);
+    return image;
+}
+
+void write_rgb8(const std::filesystem::path& path, const Rgb8& image) {
+    const render::ImageLayout layout{image.width, image.height, 3, render::PixelType::UInt8, {},
+                                     {}};
+    std::string error;
+    if (!render::write_image_bytes(path.string(), layout, std::span<const uint8_t>(image.pixels),
+                                   error))
+        throw Error(fmt::format("cannot write image '{}': {}", path.string(), error));
+}
+
+std::vector<std::filesystem::path> write_difference_images(const Rgb8& image, const Rgb8& ref,
+                                                           int tolerance,
+                                                           const std::filesystem::path& stem) {
+    const Rgb8 difference = difference_image(image, ref, tolerance);
+    std::vector<std::filesystem::path> files{stem.string() + ".diff.png"};
+    write_rgb8(files.back(), difference);
+    if (const int factor = kEnlargedWidth / std::max(image.width, image.height); factor > 1) {
+        files.push_back(fmt::format("{}.diff-x{}.png", stem.string(), factor));
+        write_rgb8(files.back(), enlarged(difference, factor));
+    }
+    return files;
 }
 
 }  // namespace tpsim::analysis

@@ -1,6 +1,7 @@
 // `tpsim compare A.json B.json ...`: statistics files side by side, each later run as a ratio
 // to the first, as text, markdown, CSV or JSON, and optionally as an HTML page.
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -8,10 +9,12 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <unistd.h>
 
 #include "sim/analysis/compare.hpp"
 #include "sim/analysis/html_report.hpp"
+#include "sim/analysis/images.hpp"
 #include "sim/cli/commands.hpp"
 #include "sim/core/error.hpp"
 
@@ -23,8 +26,40 @@ struct CompareCommandOptions {
     std::string format = "text";
     std::string output;
     std::string html;
+    std::string diff_images;
     std::vector<std::string> keys;
 };
+
+/// Writes a difference image of each later run's image against A's where the two differ, and
+/// says on standard error which files it wrote.
+void write_difference_images(const std::vector<analysis::StatsFile>& runs,
+                             const analysis::Comparison& comparison,
+                             const std::filesystem::path& dir) {
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec)
+        throw Error(fmt::format("cannot make the --diff-images folder '{}': {}; give a folder "
+                                "that can be written",
+                                dir.string(), ec.message()));
+    bool any = false;
+    for (size_t i = 1; i < runs.size(); ++i) {
+        const auto& d = comparison.images[i - 1];
+        if (!d || !d->compared() || d->differing_pixels == 0) continue;
+        const std::string b = analysis::run_letter(i);
+        const analysis::Rgb8 image = analysis::read_rgb8(*runs[i].run_file("image"), "image");
+        const analysis::Rgb8 base = analysis::read_rgb8(*runs[0].run_file("image"), "image");
+        const auto files =
+            analysis::write_difference_images(image, base, 0, dir / fmt::format("{}-vs-A", b));
+        std::vector<std::string> names;
+        for (const auto& file : files)
+            names.push_back(file.string());
+        std::cerr << fmt::format("difference image of {} against A (red: {} brighter, blue: {} "
+                                 "darker): {}\n",
+                                 b, b, b, fmt::join(names, ", "));
+        any = true;
+    }
+    if (!any) std::cerr << "difference images: none written, no image differs from A's\n";
+}
 
 int run_compare(const CompareCommandOptions& o) {
     if (o.files.size() < 2)
@@ -43,6 +78,7 @@ int run_compare(const CompareCommandOptions& o) {
                                     : o.format == "json"   ? analysis::Format::json
                                                            : analysis::Format::text;
     // Files first: a reader that closes standard output early (| head) must not cost them.
+    if (!o.diff_images.empty()) write_difference_images(runs, comparison, o.diff_images);
     if (!o.html.empty())
         write_output(o.html, analysis::comparison_page(runs, comparison, analysis::load_chart_js()),
                      "the HTML comparison");
@@ -79,6 +115,10 @@ Command add_compare_command(CLI::App& app) {
     command->add_option("-o,--output", o->output, "Write the comparison here [default: stdout]");
     command->add_option("--html", o->html,
                         "Also write a self-contained HTML page with charts here");
+    command->add_option("--diff-images", o->diff_images,
+                        "Write a difference image of each later run's image against A's into "
+                        "this folder (made if missing) where the two differ: B-vs-A.diff.png, "
+                        "and an enlarged copy of a small image");
     return {command, [o] { return run_compare(*o); }};
 }
 

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "sim/analysis/images.hpp"
 #include "sim/core/error.hpp"
 #include "sim/core/fault.hpp"
 #include "sim/render/image_codec.hpp"
@@ -21,36 +22,9 @@
 namespace tpsim::course {
 namespace {
 
-/// An 8-bit RGB image, as the references are stored.
-struct Rgb8 {
-    int width = 0, height = 0;
-    std::vector<uint8_t> pixels;  ///< row-major, row 0 at the top, 3 bytes a pixel
-};
-
-Rgb8 read_rgb8(const std::filesystem::path& path, std::string_view what) {
-    render::Image file;
-    std::string error;
-    if (!render::read_image_file(path.string(), render::PixelType::UInt8, file, error))
-        throw Error(fmt::format("cannot read {} {}: {}", what, path.string(), error));
-    const int channels = file.layout.channels;
-    if (channels < 3)
-        throw Error(fmt::format("cannot read {} {}: it must be an RGB image", what, path.string()));
-    // Channels past the third (alpha) are dropped.
-    Rgb8 image{file.layout.width, file.layout.height, {}};
-    image.pixels.resize(size_t(image.width) * image.height * 3);
-    for (size_t pixel = 0; pixel < size_t(image.width) * image.height; ++pixel)
-        std::copy_n(file.bytes.begin() + pixel * channels, 3, image.pixels.begin() + pixel * 3);
-    return image;
-}
-
-void write_rgb8(const std::filesystem::path& path, const Rgb8& image) {
-    const render::ImageLayout layout{image.width, image.height, 3, render::PixelType::UInt8, {},
-                                     {}};
-    std::string error;
-    if (!render::write_image_bytes(path.string(), layout, std::span<const uint8_t>(image.pixels),
-                                   error))
-        throw Error(fmt::format("cannot write image '{}': {}", path.string(), error));
-}
+using analysis::read_rgb8;
+using analysis::Rgb8;
+using analysis::write_rgb8;
 
 /// Counts as a person reads them: 1,234,567 for large values, 3 digits for small ones.
 std::string number(double v) {
@@ -150,47 +124,6 @@ std::string likely_cause(const Rgb8& image, const Rgb8& ref, const ImageComparis
                        "image",
                        percent(c.brighter_share), percent(1 - c.brighter_share));
 }
-
-/// The difference image: matching pixels as a dim grey copy of the reference, differing ones
-/// red where the kernel's image is brighter and blue where it is darker, brighter the larger
-/// the difference.
-Rgb8 difference_image(const Rgb8& image, const Rgb8& ref, int tolerance) {
-    Rgb8 out{ref.width, ref.height, std::vector<uint8_t>(ref.pixels.size())};
-    for (size_t p = 0; p < ref.pixels.size(); p += 3) {
-        int largest = 0, signed_sum = 0, grey = 0;
-        for (int c = 0; c < 3; ++c) {
-            const int d = int(image.pixels[p + c]) - int(ref.pixels[p + c]);
-            largest = std::max(largest, std::abs(d));
-            signed_sum += d;
-            grey += ref.pixels[p + c];
-        }
-        uint8_t* d = &out.pixels[p];
-        if (largest <= tolerance) {
-            d[0] = d[1] = d[2] = uint8_t(grey / 3 / 4);
-            continue;
-        }
-        const uint8_t strength = uint8_t(std::min(255, 128 + largest));
-        d[0] = signed_sum > 0 ? strength : 0;
-        d[1] = 0;
-        d[2] = signed_sum > 0 ? 0 : strength;
-    }
-    return out;
-}
-
-/// The image with each pixel a `factor` x `factor` square, to see single pixels of a small
-/// image on a screen.
-Rgb8 enlarged(const Rgb8& image, int factor) {
-    Rgb8 out{image.width * factor, image.height * factor, {}};
-    out.pixels.resize(size_t(out.width) * out.height * 3);
-    for (int y = 0; y < out.height; ++y)
-        for (int x = 0; x < out.width; ++x)
-            std::copy_n(&image.pixels[(size_t(y / factor) * image.width + x / factor) * 3], 3,
-                        &out.pixels[(size_t(y) * out.width + x) * 3]);
-    return out;
-}
-
-/// Difference images are enlarged to about this many pixels across.
-constexpr int kEnlargedWidth = 512;
 
 render::RenderOptions render_options(const Assignment& a, const AssignmentScene& scene,
                                      const CheckOptions& o) {
@@ -405,17 +338,9 @@ CheckReport check(const Assignment& a, const CheckOptions& o) {
                 percent(c.differing_share), a.image.tolerance, percent(a.image.max_differing));
             if (!r.passed) r.detail += " — " + likely_cause(image, ref, c, a);
             report.results.push_back(std::move(r));
-            const Rgb8 difference = difference_image(image, ref, a.image.tolerance);
-            const std::filesystem::path diff = o.output_dir / (stem + ".diff.png");
-            write_rgb8(diff, difference);
-            report.files.push_back(diff);
-            if (const int factor = kEnlargedWidth / std::max(image.width, image.height);
-                factor > 1) {
-                const std::filesystem::path large =
-                    o.output_dir / fmt::format("{}.diff-x{}.png", stem, factor);
-                write_rgb8(large, enlarged(difference, factor));
-                report.files.push_back(large);
-            }
+            for (std::filesystem::path& file : analysis::write_difference_images(
+                     image, ref, a.image.tolerance, o.output_dir / stem))
+                report.files.push_back(std::move(file));
         }
         std::optional<render::RenderResult> baseline;
         if (needs_baseline(a, scene)) {

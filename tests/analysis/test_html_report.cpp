@@ -153,3 +153,25 @@ TEST_CASE("report: a float image is embedded as an sRGB PNG, as render writes it
     CHECK(page.find("<p class=\"note\">image: cannot read image ") != std::string::npos);
     std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("difference images: grey where equal, red brighter, blue darker, and an enlarged copy",
+          "[analysis]") {
+    // Three pixels: equal, brighter by 40, darker by 200.
+    const Rgb8 ref{3, 1, {100, 100, 100, 50, 50, 50, 250, 250, 250}};
+    const Rgb8 image{3, 1, {100, 100, 100, 90, 50, 50, 50, 250, 250}};
+    const auto dir = tpsim::testing::fresh_scratch_dir("difference");
+    const auto files = write_difference_images(image, ref, 0, dir / "B-vs-A");
+    REQUIRE(files.size() == 2);
+    CHECK(files[0] == dir / "B-vs-A.diff.png");
+    CHECK(files[1] == dir / "B-vs-A.diff-x170.png");  // 512 pixels across, in whole pixels
+    const Rgb8 diff = read_rgb8(files[0], "difference image");
+    CHECK(diff.pixels == std::vector<uint8_t>{25, 25, 25, 168, 0, 0, 0, 0, 255});
+    const Rgb8 large = read_rgb8(files[1], "difference image");
+    CHECK(large.width == 510);
+    CHECK(large.height == 170);
+    CHECK(std::vector<uint8_t>(large.pixels.end() - 3, large.pixels.end()) ==
+          std::vector<uint8_t>{0, 0, 255});
+    // Within the tolerance, the brighter pixel is grey too.
+    const auto tolerant = write_difference_images(image, ref, 40, dir / "tolerant");
+    CHECK(read_rgb8(tolerant[0], "difference image").pixels[3] == 50 * 3 / 3 / 4);
+}
